@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package masa needs to build, test, run and monitor.
+# Idempotent: packages already present are left alone; safe to run again.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake pkg-config git
+  # core libraries
+  libeigen3-dev libyaml-cpp-dev libcli11-dev libomp-dev
+  # simulation
+  libmujoco-dev libmujoco-samples
+  # transport, tools and Java bindings (lcm-spy needs a JDK to build the types jar, and jchart2d)
+  liblcm-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # offscreen rendering of rollouts, plots
+  libglfw3-dev xvfb xauth ffmpeg libpng-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all ${#packages[@]} packages present."
+  exit 0
+fi
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+echo "install_deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "install_deps: done."
