@@ -11,7 +11,8 @@ packages=(
   # simulation
   libmujoco-dev libmujoco-samples
   # transport, tools and Java bindings (lcm-spy needs a JDK to build the types jar, and jchart2d)
-  liblcm-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java
+  # (liblcm-dev needs glib headers but does not pull them in)
+  liblcm-dev libglib2.0-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # offscreen rendering of rollouts, plots
