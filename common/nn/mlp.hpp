@@ -10,6 +10,7 @@
 
 #include "common/core/types.hpp"
 #include "common/nn/activation.hpp"
+#include "common/nn/gemm.hpp"
 #include "common/nn/parameter_set.hpp"
 
 namespace masa::nn {
@@ -60,8 +61,11 @@ class Mlp {
   std::vector<Mat<S>> z_, y_;
   Mat<S> input_;  // copy of the last forward's input (needed for the first layer's weight grad)
   Mat<S> grad_a_, grad_b_;
+  // Products run on owned packing buffers (see gemm.hpp); per layer: forward, weight grad, input grad.
+  GemmWorkspace<S> gemm_;
+  std::vector<GemmPlan> plans_;
   int capacity_ = 0;
-  int batch_ = 0;
+  int batch_ = -1;  // columns of the last forward(); -1 when there is no cache for backward
 };
 
 }  // namespace masa::nn

@@ -1,0 +1,106 @@
+// Adam (Kingma & Ba) with bias correction, in PyTorch's arrangement of the update:
+//   p -= (lr / (1 - b1^t)) * m / (sqrt(v) / sqrt(1 - b2^t) + eps).
+#include "common/nn/adam.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <istream>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+
+#include "common/core/check.hpp"
+
+namespace masa::nn {
+
+namespace {
+constexpr char kAdamMagic[8] = {'M', 'A', 'S', 'A', 'A', 'D', 'M', '1'};
+
+template <typename T>
+void writePod(std::ostream& os, const T& v) {
+  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <typename T>
+void readPod(std::istream& is, T& v, const char* what) {
+  if (!is.read(reinterpret_cast<char*>(&v), sizeof(T)))
+    throw std::runtime_error(std::string("Adam state: stream ends while reading ") + what);
+}
+}  // namespace
+
+template <typename S>
+Adam<S>::Adam(ParameterSet<S>& params, AdamConfig<S> config) : params_(&params), config_(config) {
+  MASA_CHECK(params.finalized(), "Adam needs a finalized parameter set");
+  m_ = Vec<S>::Zero(params.size());
+  v_ = Vec<S>::Zero(params.size());
+}
+
+template <typename S>
+void Adam<S>::step() {
+  MASA_CHECK(params_->size() == m_.size(), "Adam: parameter set has " << params_->size() << " values, state has " << m_.size());
+  MASA_CHECK(config_.lr >= S(0) && config_.eps > S(0), "Adam: lr " << config_.lr << ", eps " << config_.eps);
+  ++t_;
+  const S b1 = config_.beta1, b2 = config_.beta2;
+  // Bias corrections in double: b2^t for b2 = 0.999 stays accurate far beyond float's reach.
+  const double bc1 = 1.0 - std::pow(static_cast<double>(b1), static_cast<double>(t_));
+  const double bc2 = 1.0 - std::pow(static_cast<double>(b2), static_cast<double>(t_));
+  const S step_size = static_cast<S>(config_.lr / bc1);
+  const S inv_sqrt_bc2 = static_cast<S>(1.0 / std::sqrt(bc2));
+  auto g = params_->grads().array();
+  m_.array() = b1 * m_.array() + (S(1) - b1) * g;
+  v_.array() = b2 * v_.array() + (S(1) - b2) * g.square();
+  params_->values().array() -= step_size * m_.array() / (v_.array().sqrt() * inv_sqrt_bc2 + config_.eps);
+}
+
+template <typename S>
+void Adam<S>::save(std::ostream& os) const {
+  os.write(kAdamMagic, sizeof(kAdamMagic));
+  writePod(os, static_cast<std::uint32_t>(sizeof(S)));
+  writePod(os, static_cast<std::int64_t>(m_.size()));
+  writePod(os, static_cast<std::int64_t>(t_));
+  os.write(reinterpret_cast<const char*>(m_.data()), static_cast<std::streamsize>(m_.size() * sizeof(S)));
+  os.write(reinterpret_cast<const char*>(v_.data()), static_cast<std::streamsize>(v_.size() * sizeof(S)));
+  if (!os) throw std::runtime_error("Adam state: write failed");
+}
+
+template <typename S>
+void Adam<S>::load(std::istream& is) {
+  char magic[sizeof(kAdamMagic)];
+  if (!is.read(magic, sizeof(magic))) throw std::runtime_error("Adam state: stream ends while reading the magic");
+  if (std::memcmp(magic, kAdamMagic, sizeof(magic)) != 0) throw std::runtime_error("Adam state: bad magic (not an Adam state)");
+  std::uint32_t scalar = 0;
+  std::int64_t n = 0, t = 0;
+  readPod(is, scalar, "the scalar size");
+  if (scalar != sizeof(S))
+    throw std::runtime_error("Adam state: scalar size " + std::to_string(scalar) + " in the stream, " +
+                             std::to_string(sizeof(S)) + " in the optimizer");
+  readPod(is, n, "the state size");
+  if (n != m_.size())
+    throw std::runtime_error("Adam state: " + std::to_string(n) + " moments in the stream, " +
+                             std::to_string(m_.size()) + " parameters in the optimizer");
+  readPod(is, t, "the step count");
+  if (t < 0) throw std::runtime_error("Adam state: negative step count " + std::to_string(t));
+  // Read into temporaries so that a truncated stream leaves the optimizer as it was.
+  Vec<S> m(n), v(n);
+  const auto bytes = static_cast<std::streamsize>(n * sizeof(S));
+  if (!is.read(reinterpret_cast<char*>(m.data()), bytes) || !is.read(reinterpret_cast<char*>(v.data()), bytes))
+    throw std::runtime_error("Adam state: stream ends inside the moments");
+  m_.swap(m);
+  v_.swap(v);
+  t_ = t;
+}
+
+template <typename S>
+S clipGradNorm(ParameterSet<S>& params, S max_norm) {
+  MASA_CHECK(max_norm > S(0), "clipGradNorm: max_norm must be positive, got " << max_norm);
+  const S norm = params.grads().norm();
+  if (norm > max_norm) params.grads() *= max_norm / norm;
+  return norm;
+}
+
+template class Adam<float>;
+template class Adam<double>;
+template float clipGradNorm<float>(ParameterSet<float>&, float);
+template double clipGradNorm<double>(ParameterSet<double>&, double);
+
+}  // namespace masa::nn
