@@ -1,0 +1,279 @@
+#include "common/config/run_config.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "common/core/config_error.hpp"
+
+namespace masa::config {
+namespace fs = std::filesystem;
+namespace {
+
+const char* kCommandLine = "command line";
+
+bool isOpenSection(const std::string& path) { return path == "env" || path.rfind("env.", 0) == 0; }
+
+std::string join(const std::string& prefix, const std::string& key) { return prefix.empty() ? key : prefix + "." + key; }
+
+std::string kindName(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Map: return "a map";
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Scalar: return "a value";
+    case YAML::NodeType::Null: return "empty";
+    default: return "undefined";
+  }
+}
+
+YAML::Node loadYamlFile(const std::string& path, const std::string& key_for_missing) {
+  if (!fs::exists(path)) throw ConfigError(path, key_for_missing, "file not found");
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path, "(syntax)", "YAML error at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+}
+
+// Deep merge without a schema (open sections): maps merge key by key, anything else replaces.
+void mergeOpen(YAML::Node dst, const YAML::Node& src, const std::string& path, const std::string& file,
+               std::map<std::string, std::string>& origin) {
+  for (const auto& kv : src) {
+    const std::string key = kv.first.as<std::string>();
+    if (kv.second.IsMap() && dst[key].IsMap()) {
+      mergeOpen(dst[key], kv.second, join(path, key), file, origin);
+    } else {
+      dst[key] = YAML::Clone(kv.second);
+      origin[join(path, key)] = file;
+    }
+  }
+}
+
+// Overlays `src` onto `dst` (a clone of the schema tree), checking every key against `schema`.
+void overlay(YAML::Node dst, const YAML::Node& src, const YAML::Node& schema, const std::string& path,
+             const std::string& file, std::map<std::string, std::string>& origin) {
+  if (!src.IsMap()) throw ConfigError(file, path.empty() ? "(root)" : path, "expected a map, got " + kindName(src));
+  for (const auto& kv : src) {
+    const std::string key = kv.first.as<std::string>();
+    const std::string full = join(path, key);
+    const YAML::Node value = kv.second;
+    if (isOpenSection(full)) {
+      if (value.IsMap() && dst[key].IsMap()) {
+        mergeOpen(dst[key], value, full, file, origin);
+      } else {
+        dst[key] = YAML::Clone(value);
+        origin[full] = file;
+      }
+      continue;
+    }
+    const YAML::Node expected = schema[key];
+    if (!expected) {
+      std::string known;
+      for (const auto& s : schema) known += (known.empty() ? "" : ", ") + s.first.as<std::string>();
+      throw ConfigError(file, full, "unknown key (known here: " + known + ")");
+    }
+    if (expected.IsMap()) {
+      overlay(dst[key], value, expected, full, file, origin);
+    } else {
+      if (expected.IsSequence() && !value.IsSequence())
+        throw ConfigError(file, full, "expected a list, got " + kindName(value));
+      if (expected.IsScalar() && !value.IsScalar())
+        throw ConfigError(file, full, "expected a value, got " + kindName(value));
+      dst[key] = YAML::Clone(value);
+      origin[full] = file;
+    }
+  }
+}
+
+// Typed readers that name the origin of the key on failure.
+class Reader {
+ public:
+  Reader(const YAML::Node& root, const std::map<std::string, std::string>& origin, std::string defaults_file)
+      : root_(root), origin_(origin), defaults_(std::move(defaults_file)) {}
+
+  YAML::Node node(const std::string& path) const {
+    YAML::Node n;
+    n.reset(root_);  // reset() rebinds; operator= would overwrite the node's contents
+    std::stringstream ss(path);
+    std::string part;
+    while (std::getline(ss, part, '.')) n.reset(n[part]);
+    return n;
+  }
+  std::string originOf(const std::string& path) const {
+    auto it = origin_.find(path);
+    return it == origin_.end() ? defaults_ : it->second;
+  }
+  template <typename T>
+  T get(const std::string& path, const char* what) const {
+    const YAML::Node n = node(path);
+    try {
+      return n.as<T>();
+    } catch (const YAML::Exception&) {
+      throw ConfigError(originOf(path), path, std::string("expected ") + what + ", got '" + YAML::Dump(n) + "'");
+    }
+  }
+  double positive(const std::string& path) const {
+    const double v = get<double>(path, "a number");
+    if (!(v > 0)) throw ConfigError(originOf(path), path, "must be positive, got " + std::to_string(v));
+    return v;
+  }
+  double nonNegative(const std::string& path) const {
+    const double v = get<double>(path, "a number");
+    if (!(v >= 0)) throw ConfigError(originOf(path), path, "must not be negative, got " + std::to_string(v));
+    return v;
+  }
+  double unitInterval(const std::string& path) const {
+    const double v = get<double>(path, "a number");
+    if (!(v > 0 && v <= 1)) throw ConfigError(originOf(path), path, "must be in (0, 1], got " + std::to_string(v));
+    return v;
+  }
+  int atLeast(const std::string& path, int lo) const {
+    const int v = get<int>(path, "an integer");
+    if (v < lo) throw ConfigError(originOf(path), path, "must be at least " + std::to_string(lo) + ", got " + std::to_string(v));
+    return v;
+  }
+  std::vector<int> widths(const std::string& path, bool allow_empty) const {
+    const auto v = get<std::vector<int>>(path, "a list of integers");
+    if (v.empty() && !allow_empty) throw ConfigError(originOf(path), path, "needs at least one layer width");
+    for (int w : v)
+      if (w < 1) throw ConfigError(originOf(path), path, "layer widths must be positive, got " + std::to_string(w));
+    return v;
+  }
+
+ private:
+  const YAML::Node& root_;
+  const std::map<std::string, std::string>& origin_;
+  std::string defaults_;
+};
+
+}  // namespace
+
+std::string defaultConfigsDir() {
+  if (const char* env = std::getenv("MASA_CONFIGS")) return env;
+  return std::string(MASA_SOURCE_DIR) + "/configs";
+}
+
+RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides) {
+  const std::string defaults_file = configs_dir + "/defaults.yaml";
+  const YAML::Node schema = loadYamlFile(defaults_file, "(file)");
+  RunConfig rc;
+  YAML::Node merged = YAML::Clone(schema);
+
+  // Parse overrides first: the task they name decides which task file is read.
+  std::vector<std::pair<std::string, YAML::Node>> parsed;
+  std::string task = schema["task"].as<std::string>();
+  for (const std::string& o : overrides) {
+    const auto eq = o.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw ConfigError(kCommandLine, o, "expected key.path=value");
+    const std::string path = o.substr(0, eq);
+    YAML::Node value;
+    try {
+      value = YAML::Load(o.substr(eq + 1));
+    } catch (const YAML::Exception& e) {
+      throw ConfigError(kCommandLine, path, "value is not valid YAML: " + e.msg);
+    }
+    if (path == "task") task = value.as<std::string>();
+    parsed.emplace_back(path, value);
+  }
+
+  const std::string task_file = configs_dir + "/tasks/" + task + ".yaml";
+  if (!fs::exists(task_file)) {
+    std::string known;
+    if (fs::exists(configs_dir + "/tasks"))
+      for (const auto& e : fs::directory_iterator(configs_dir + "/tasks"))
+        if (e.path().extension() == ".yaml") known += (known.empty() ? "" : ", ") + e.path().stem().string();
+    throw ConfigError(task_file, "task", "unknown task '" + task + "' (known: " + known + ")");
+  }
+  const YAML::Node task_node = loadYamlFile(task_file, "task");
+  if (task_node.IsDefined() && !task_node.IsNull()) overlay(merged, task_node, schema, "", task_file, rc.origin);
+
+  for (const auto& [path, value] : parsed) {
+    // Build {a: {b: value}} and overlay it, so overrides get exactly the file checks.
+    YAML::Node wrapped;
+    wrapped.reset(value);
+    std::vector<std::string> parts;
+    std::stringstream ss(path);
+    std::string part;
+    while (std::getline(ss, part, '.')) parts.push_back(part);
+    for (auto it = parts.rbegin(); it != parts.rend(); ++it) {
+      YAML::Node m(YAML::NodeType::Map);
+      m[*it] = wrapped;
+      wrapped.reset(m);
+    }
+    overlay(merged, wrapped, schema, "", kCommandLine, rc.origin);
+  }
+
+  const Reader r(merged, rc.origin, defaults_file);
+  rc.task = r.get<std::string>("task", "a task name");
+  try {
+    rc.method = model::parseMethod(r.get<std::string>("method", "a method name"));
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(r.originOf("method"), "method", e.what());
+  }
+  rc.seed = r.get<std::uint64_t>("seed", "a non-negative integer");
+  rc.spec_path = r.get<std::string>("spec", "a file path");
+  if (rc.spec_path.empty()) rc.spec_path = configs_dir + "/specs/" + rc.task + ".yaml";
+
+  model::ModelConfig& m = rc.model;
+  m.method = rc.method;
+  m.policy_hidden = r.widths("model.policy_hidden", false);
+  m.critic_hidden = r.widths("model.critic_hidden", false);
+  m.critic_head_hidden = r.widths("model.critic_head_hidden", true);
+  try {
+    m.activation = nn::parseActivation(r.get<std::string>("model.activation", "an activation name"));
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(r.originOf("model.activation"), "model.activation", e.what());
+  }
+  m.init_log_std = r.get<double>("model.init_log_std", "a number");
+  m.policy_last_layer_scale = r.positive("model.policy_last_layer_scale");
+  m.normalize_obs = r.get<bool>("model.normalize_input", "true or false");
+  m.sasa_policy_coef = r.nonNegative("model.sasa_policy_coef");
+  m.sasa_value_coef = r.nonNegative("model.sasa_value_coef");
+
+  PpoConfig& p = rc.ppo;
+  p.num_envs = r.atLeast("ppo.num_envs", 1);
+  p.horizon = r.atLeast("ppo.horizon", 1);
+  p.minibatch_size = r.atLeast("ppo.minibatch_size", 1);
+  p.mini_epochs = r.atLeast("ppo.mini_epochs", 1);
+  p.learning_rate = r.positive("ppo.learning_rate");
+  p.lr_schedule = r.get<std::string>("ppo.lr_schedule", "adaptive or fixed");
+  if (p.lr_schedule != "adaptive" && p.lr_schedule != "fixed")
+    throw ConfigError(r.originOf("ppo.lr_schedule"), "ppo.lr_schedule",
+                      "expected 'adaptive' or 'fixed', got '" + p.lr_schedule + "'");
+  p.kl_threshold = r.positive("ppo.kl_threshold");
+  p.lr_min = r.positive("ppo.lr_min");
+  p.lr_max = r.positive("ppo.lr_max");
+  if (p.lr_min > p.lr_max) throw ConfigError(r.originOf("ppo.lr_min"), "ppo.lr_min", "must not exceed ppo.lr_max");
+  p.gamma = r.unitInterval("ppo.gamma");
+  p.tau = r.unitInterval("ppo.tau");
+  p.e_clip = r.positive("ppo.e_clip");
+  p.entropy_coef = r.nonNegative("ppo.entropy_coef");
+  p.critic_coef = r.nonNegative("ppo.critic_coef");
+  p.bounds_loss_coef = r.nonNegative("ppo.bounds_loss_coef");
+  p.soft_bound = r.positive("ppo.soft_bound");
+  p.grad_norm = r.positive("ppo.grad_norm");
+  p.normalize_value = r.get<bool>("ppo.normalize_value", "true or false");
+  p.normalize_advantage = r.get<bool>("ppo.normalize_advantage", "true or false");
+  p.value_bootstrap = r.get<bool>("ppo.value_bootstrap", "true or false");
+  p.max_epochs = r.atLeast("ppo.max_epochs", 1);
+  p.max_policy_lag = r.atLeast("ppo.max_policy_lag", 0);
+
+  rc.env = YAML::Clone(merged["env"]);
+  rc.resolved = merged;
+  return rc;
+}
+
+std::string dumpResolved(const RunConfig& config) {
+  std::ostringstream os;
+  os << "# Resolved masa run configuration (defaults < task file < command line).\n";
+  std::map<std::string, int> files;
+  for (const auto& [key, file] : config.origin) files[file]++;
+  for (const auto& [file, n] : files) os << "# " << n << " key(s) from " << file << "\n";
+  YAML::Emitter out;
+  out << config.resolved;
+  os << out.c_str() << "\n";
+  return os.str();
+}
+
+}  // namespace masa::config

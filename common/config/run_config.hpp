@@ -1,0 +1,65 @@
+// The configuration of a run: configs/defaults.yaml, overridden by configs/tasks/<task>.yaml,
+// overridden by command-line `key.path=value` settings. defaults.yaml is also the schema: a key it
+// does not have is an error (outside open sections such as env), and every error names the file
+// (or "command line") and the key path.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "common/model/actor_critic.hpp"
+
+namespace masa::config {
+
+struct PpoConfig {
+  int num_envs = 4096;
+  int horizon = 32;
+  int minibatch_size = 32768;
+  int mini_epochs = 5;
+  double learning_rate = 5e-4;
+  std::string lr_schedule = "adaptive";  // adaptive | fixed
+  double kl_threshold = 0.0008;
+  double lr_min = 1e-6;
+  double lr_max = 1e-2;
+  double gamma = 0.99;
+  double tau = 0.95;
+  double e_clip = 0.2;
+  double entropy_coef = 0.0;
+  double critic_coef = 4.0;
+  double bounds_loss_coef = 1e-4;
+  double soft_bound = 1.1;
+  double grad_norm = 1.0;
+  bool normalize_value = true;
+  bool normalize_advantage = true;
+  bool value_bootstrap = true;
+  int max_epochs = 10000;
+  int max_policy_lag = 0;
+};
+
+struct RunConfig {
+  std::string task;
+  model::Method method = model::Method::kMasa;
+  std::uint64_t seed = 0;
+  std::string spec_path;  // resolved: absolute or relative to the configs dir's parent
+  model::ModelConfig model;
+  PpoConfig ppo;
+  YAML::Node env;         // task parameters, read by the task
+  YAML::Node resolved;    // the whole merged tree, for the run directory
+  std::map<std::string, std::string> origin;  // key path -> file (or "command line") that set it
+};
+
+// configs_dir holds defaults.yaml, tasks/ and specs/. overrides are "a.b=value" strings where value
+// is YAML (1e-4, true, [256, 128], elu).
+RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides);
+
+// The configs directory of this source tree (MASA_SOURCE_DIR/configs) unless MASA_CONFIGS is set.
+std::string defaultConfigsDir();
+
+// YAML text of the resolved configuration, with a header comment naming its sources.
+std::string dumpResolved(const RunConfig& config);
+
+}  // namespace masa::config

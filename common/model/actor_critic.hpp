@@ -1,0 +1,101 @@
+// The trainable model of one method: normalizer, policy mean, tied log-std, critic, and (for
+// SASA) the symmetry losses, with all parameters in one flat ParameterSet so that one Adam,
+// one grad-norm clip and one broadcast serve them all.
+//
+// Training use:   forward(raw_obs) -> mean(), logStd(), value()
+//                 backward(dmean, dlog_std, dvalue)   (adds the SASA losses' gradients itself)
+// Acting use:     actMean(raw_obs) and logStd().
+#pragma once
+
+#include <iosfwd>
+#include <memory>
+#include <vector>
+
+#include "common/model/agent_maps.hpp"
+#include "common/model/method.hpp"
+#include "common/model/running_mean_std.hpp"
+#include "common/model/shared_agent_critic.hpp"
+#include "common/model/shared_agent_policy.hpp"
+#include "common/model/tied_log_std.hpp"
+#include "common/nn/parameter_set.hpp"
+#include "common/symmetry/symmetry_spec.hpp"
+
+namespace masa::model {
+
+struct ModelConfig {
+  Method method = Method::kMasa;
+  std::vector<int> policy_hidden{400, 200, 100};  // Phi
+  std::vector<int> critic_hidden{400, 200, 100};  // Psi (last width = features pooled over agents)
+  std::vector<int> critic_head_hidden{};          // Theta's hidden widths (empty: linear head)
+  nn::Activation activation = nn::Activation::kElu;
+  double init_log_std = 0.0;
+  double policy_last_layer_scale = 0.01;  // small initial actions
+  double sasa_policy_coef = 1.0;          // weight of ||T_i A(o) - A(T_i o)||^2
+  double sasa_value_coef = 1.0;           // weight of |V(o) - V(T_i o)|
+  bool normalize_obs = true;
+};
+
+template <typename S>
+class ActorCritic {
+ public:
+  ActorCritic(const sym::SymmetrySpec& spec, const ModelConfig& config);
+  ActorCritic(const ActorCritic&) = delete;
+  ActorCritic& operator=(const ActorCritic&) = delete;
+
+  void initialize(Rng& rng);
+
+  const ModelConfig& config() const { return config_; }
+  const sym::SymmetrySpec& spec() const { return spec_; }
+  int obsDim() const { return spec_.obsDim(); }
+  int actDim() const { return spec_.actDim(); }
+
+  nn::ParameterSet<S>& params() { return params_; }
+  const nn::ParameterSet<S>& params() const { return params_; }
+  RunningMeanStd<S>& obsNormalizer() { return obs_norm_; }
+  RunningMeanStd<S>& valueNormalizer() { return value_norm_; }
+
+  // Training forward on raw observations (obs_dim x B); caches for backward.
+  void forward(const ConstMatRef<S>& raw_obs);
+  Eigen::Map<const Mat<S>> mean() const;   // act_dim x B
+  Eigen::Map<const Mat<S>> value() const;  // 1 x B, in normalized value units
+  void logStd(VecRef<S> out) const;
+  // SASA losses of the last forward, already weighted (0 for other methods).
+  S symmetryPolicyLoss() const { return sym_policy_loss_; }
+  S symmetryValueLoss() const { return sym_value_loss_; }
+
+  // Accumulates gradients of the caller's loss (plus the SASA losses for SASA).
+  void backward(const ConstMatRef<S>& dmean, const ConstVecRef<S>& dlog_std, const ConstMatRef<S>& dvalue);
+
+  // Mean action only (for actors): no critic work.
+  Eigen::Map<const Mat<S>> actMean(const ConstMatRef<S>& raw_obs);
+
+  // Parameters and normalizer statistics, for checkpoints.
+  void save(std::ostream& os) const;
+  void load(std::istream& is, const std::string& source_name);
+
+ private:
+  std::vector<int> logStdClasses() const;
+  void normalizeInput(const ConstMatRef<S>& raw_obs);
+  void computeSymmetryLosses();
+
+  sym::SymmetrySpec spec_;
+  ModelConfig config_;
+  AgentMaps maps_;
+  nn::ParameterSet<S> params_;
+  SharedAgentPolicy<S> policy_;
+  TiedLogStd<S> log_std_;
+  SharedAgentCritic<S> critic_;
+  RunningMeanStd<S> obs_norm_;
+  RunningMeanStd<S> value_norm_;
+
+  Mat<S> obs_normalized_;
+  const S* value_ptr_ = nullptr;  // critic output of the last forward (1 x numPooled*B)
+  const S* mean_ptr_ = nullptr;
+  int batch_ = 0;
+  // SASA scratch: gradients on the orbit copies' actions and values, and residuals.
+  std::vector<sym::SparseMap> act_t_transpose_;
+  Mat<S> sym_dagent_, sym_residual_, dvalues_;
+  S sym_policy_loss_ = S(0), sym_value_loss_ = S(0);
+};
+
+}  // namespace masa::model

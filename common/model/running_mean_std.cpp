@@ -1,0 +1,140 @@
+#include "common/model/running_mean_std.hpp"
+
+#include <algorithm>
+#include <istream>
+#include <ostream>
+#include <stdexcept>
+
+#include "common/core/check.hpp"
+
+namespace masa::model {
+
+template <typename S>
+RunningMeanStd<S>::RunningMeanStd(int dim, double epsilon)
+    : dim_(dim),
+      epsilon_(epsilon),
+      count_(0.0),
+      mean_(Eigen::VectorXd::Zero(dim)),
+      var_(Eigen::VectorXd::Ones(dim)) {
+  MASA_CHECK(dim > 0, "normalizer dimension must be positive, got " << dim);
+  refreshEffective();
+}
+
+template <typename S>
+void RunningMeanStd<S>::setSymmetry(const std::vector<sym::SparseMap>& transforms, const std::vector<int>& classes) {
+  MASA_CHECK(static_cast<int>(classes.size()) == dim_, "classes has " << classes.size() << " entries, dim " << dim_);
+  for (const auto& t : transforms)
+    MASA_CHECK(t.rows() == dim_ && t.cols() == dim_, "transform is " << t.rows() << "x" << t.cols() << ", dim " << dim_);
+  transforms_ = transforms;
+  classes_ = classes;
+  refreshEffective();
+}
+
+template <typename S>
+void RunningMeanStd<S>::update(const ConstMatRef<S>& batch) {
+  MASA_CHECK(batch.rows() == dim_, "batch has " << batch.rows() << " rows, normalizer dim " << dim_);
+  if (batch.cols() == 0) return;
+  // One pass of sums in double over the batch, or over its whole orbit when symmetric.
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(dim_), sum_sq = Eigen::VectorXd::Zero(dim_);
+  auto accumulate = [&](const auto& x) {
+    for (Eigen::Index b = 0; b < x.cols(); ++b)
+      for (int d = 0; d < dim_; ++d) {
+        const double v = static_cast<double>(x(d, b));
+        sum(d) += v;
+        sum_sq(d) += v * v;
+      }
+  };
+  double n = static_cast<double>(batch.cols());
+  if (transforms_.empty()) {
+    accumulate(batch);
+  } else {
+    if (orbit_scratch_.cols() < batch.cols()) orbit_scratch_.resize(dim_, batch.cols());
+    auto y = orbit_scratch_.leftCols(batch.cols());
+    for (const auto& t : transforms_) {
+      t.template apply<S>(batch, y);
+      accumulate(y);
+    }
+    n *= static_cast<double>(transforms_.size());
+  }
+  const Eigen::VectorXd batch_mean = sum / n;
+  const Eigen::VectorXd batch_var = (sum_sq / n - batch_mean.cwiseAbs2()).cwiseMax(0.0);
+  const double total = count_ + n;
+  const Eigen::VectorXd delta = batch_mean - mean_;
+  mean_ += delta * (n / total);
+  var_ = (var_ * count_ + batch_var * n + delta.cwiseAbs2() * (count_ * n / total)) / total;
+  count_ = total;
+  refreshEffective();
+}
+
+template <typename S>
+void RunningMeanStd<S>::refreshEffective() {
+  mean_eff_ = mean_;
+  var_eff_ = var_;
+  if (!transforms_.empty()) {
+    // Project the mean onto the subspace fixed by every T_i.
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(dim_, 1), tm(dim_, 1);
+    for (const auto& t : transforms_) {
+      t.template apply<double>(mean_, tm);
+      m += tm;
+    }
+    mean_eff_ = m.col(0) / static_cast<double>(transforms_.size());
+    // Tie variances within each orbit class (a rotating vector gets one variance).
+    const int num_classes = classes_.empty() ? 0 : *std::max_element(classes_.begin(), classes_.end()) + 1;
+    Eigen::VectorXd class_sum = Eigen::VectorXd::Zero(num_classes), class_n = Eigen::VectorXd::Zero(num_classes);
+    for (int d = 0; d < dim_; ++d) {
+      class_sum(classes_[d]) += var_(d);
+      class_n(classes_[d]) += 1.0;
+    }
+    for (int d = 0; d < dim_; ++d) var_eff_(d) = class_sum(classes_[d]) / class_n(classes_[d]);
+  }
+  shift_ = mean_eff_.cast<S>();
+  const Eigen::VectorXd scale = (var_eff_.array() + epsilon_).sqrt();
+  scale_ = scale.cast<S>();
+  inv_scale_ = scale.cwiseInverse().cast<S>();
+}
+
+template <typename S>
+void RunningMeanStd<S>::normalize(const ConstMatRef<S>& in, MatRef<S> out) const {
+  MASA_CHECK(in.rows() == dim_ && out.rows() == dim_ && in.cols() == out.cols(), "normalize: shapes differ");
+  out = (in.colwise() - shift_).array().colwise() * inv_scale_.array();
+}
+
+template <typename S>
+void RunningMeanStd<S>::denormalize(const ConstMatRef<S>& in, MatRef<S> out) const {
+  MASA_CHECK(in.rows() == dim_ && out.rows() == dim_ && in.cols() == out.cols(), "denormalize: shapes differ");
+  out = (in.array().colwise() * scale_.array()).matrix().colwise() + shift_;
+}
+
+template <typename S>
+void RunningMeanStd<S>::save(std::ostream& os) const {
+  const int32_t d = dim_;
+  os.write(reinterpret_cast<const char*>(&d), sizeof d);
+  os.write(reinterpret_cast<const char*>(&count_), sizeof count_);
+  os.write(reinterpret_cast<const char*>(mean_.data()), sizeof(double) * dim_);
+  os.write(reinterpret_cast<const char*>(var_.data()), sizeof(double) * dim_);
+}
+
+template <typename S>
+void RunningMeanStd<S>::load(std::istream& is) {
+  int32_t d = 0;
+  is.read(reinterpret_cast<char*>(&d), sizeof d);
+  if (!is) throw std::runtime_error("normalizer state is truncated");
+  if (d != dim_)
+    throw std::runtime_error("normalizer state has dimension " + std::to_string(d) + ", expected " +
+                             std::to_string(dim_));
+  double count = 0;
+  Eigen::VectorXd mean(dim_), var(dim_);
+  is.read(reinterpret_cast<char*>(&count), sizeof count);
+  is.read(reinterpret_cast<char*>(mean.data()), sizeof(double) * dim_);
+  is.read(reinterpret_cast<char*>(var.data()), sizeof(double) * dim_);
+  if (!is) throw std::runtime_error("normalizer state is truncated");
+  count_ = count;
+  mean_ = mean;
+  var_ = var;
+  refreshEffective();
+}
+
+template class RunningMeanStd<float>;
+template class RunningMeanStd<double>;
+
+}  // namespace masa::model

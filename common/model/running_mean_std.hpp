@@ -1,0 +1,52 @@
+// Running mean and variance of a stream of batches (Chan et al.'s parallel update, in double),
+// used to normalize observations and value targets.
+//
+// With a symmetry attached, every batch is counted together with its whole group orbit {T_i x},
+// then the mean is projected onto the invariant subspace ((1/N) sum_i T_i m) and variances are
+// averaged within each orbit class. The normalizer then commutes with every T_i, so it keeps the
+// policy equivariant and the critic invariant.
+#pragma once
+
+#include <iosfwd>
+#include <vector>
+
+#include "common/core/types.hpp"
+#include "common/symmetry/sparse_map.hpp"
+
+namespace masa::model {
+
+template <typename S>
+class RunningMeanStd {
+ public:
+  explicit RunningMeanStd(int dim, double epsilon = 1e-5);
+
+  void setSymmetry(const std::vector<sym::SparseMap>& transforms, const std::vector<int>& classes);
+  bool symmetric() const { return !transforms_.empty(); }
+
+  void update(const ConstMatRef<S>& batch);  // dim x B
+  void normalize(const ConstMatRef<S>& in, MatRef<S> out) const;    // (x - mean) / sqrt(var + eps)
+  void denormalize(const ConstMatRef<S>& in, MatRef<S> out) const;  // x * sqrt(var + eps) + mean
+
+  int dim() const { return dim_; }
+  double count() const { return count_; }
+  const Eigen::VectorXd& mean() const { return mean_eff_; }
+  const Eigen::VectorXd& var() const { return var_eff_; }
+
+  void save(std::ostream& os) const;
+  void load(std::istream& is);  // throws std::runtime_error on a dimension mismatch or truncation
+
+ private:
+  void refreshEffective();
+
+  int dim_;
+  double epsilon_;
+  double count_;
+  Eigen::VectorXd mean_, var_;          // raw running statistics (of the orbit, when symmetric)
+  Eigen::VectorXd mean_eff_, var_eff_;  // projected statistics actually used
+  Vec<S> shift_, scale_, inv_scale_;    // cached in S: mean, sqrt(var + eps), and its inverse
+  std::vector<sym::SparseMap> transforms_;
+  std::vector<int> classes_;
+  Mat<S> orbit_scratch_;
+};
+
+}  // namespace masa::model

@@ -1,0 +1,152 @@
+// Run configuration: the paper's values per task, overrides, and errors that name file and key.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "common/config/run_config.hpp"
+#include "common/core/config_error.hpp"
+
+namespace masa::config {
+namespace {
+namespace fs = std::filesystem;
+
+const std::string kConfigs = std::string(MASA_SOURCE_DIR) + "/configs";
+
+// A scratch configs dir with the real defaults and one task file of our own.
+class ScratchConfigs : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("masa_cfg_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_ / "tasks");
+    fs::copy_file(kConfigs + "/defaults.yaml", dir_ / "defaults.yaml");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string writeTask(const std::string& name, const std::string& text) {
+    const auto p = dir_ / "tasks" / (name + ".yaml");
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  ConfigError expectError(const std::vector<std::string>& overrides) {
+    try {
+      loadRunConfig(dir_.string(), overrides);
+    } catch (const ConfigError& e) {
+      return e;
+    }
+    ADD_FAILURE() << "expected a ConfigError";
+    return ConfigError("", "", "");
+  }
+  fs::path dir_;
+};
+
+TEST(RunConfig, EveryShippedTaskLoadsWithThePapersHyperparameters) {
+  struct Want {
+    const char* task;
+    int envs, horizon, minibatch, epochs;
+    double lr, critic;
+    int width0;
+  };
+  const Want wants[] = {{"humanoid_tightrope", 4096, 32, 32768, 5, 5e-4, 4.0, 400},
+                        {"humanoid_dribbling", 4096, 32, 32768, 5, 5e-4, 4.0, 400},
+                        {"trifinger_lift", 16384, 16, 16384, 4, 3e-4, 4.0, 256},
+                        {"a1_beam", 4096, 24, 32768, 5, 3e-4, 2.0, 256},
+                        {"ant_acrobatic", 4096, 16, 32768, 4, 3e-4, 2.0, 256}};
+  for (const auto& w : wants) {
+    const RunConfig c = loadRunConfig(kConfigs, {std::string("task=") + w.task});
+    EXPECT_EQ(c.task, w.task);
+    EXPECT_EQ(c.ppo.num_envs, w.envs) << w.task;
+    EXPECT_EQ(c.ppo.horizon, w.horizon) << w.task;
+    EXPECT_EQ(c.ppo.minibatch_size, w.minibatch) << w.task;
+    EXPECT_EQ(c.ppo.mini_epochs, w.epochs) << w.task;
+    EXPECT_DOUBLE_EQ(c.ppo.learning_rate, w.lr) << w.task;
+    EXPECT_DOUBLE_EQ(c.ppo.critic_coef, w.critic) << w.task;
+    EXPECT_EQ(c.model.policy_hidden.front(), w.width0) << w.task;
+    EXPECT_DOUBLE_EQ(c.ppo.kl_threshold, 0.0008);
+    EXPECT_DOUBLE_EQ(c.ppo.gamma, 0.99);
+    EXPECT_DOUBLE_EQ(c.ppo.tau, 0.95);
+    EXPECT_DOUBLE_EQ(c.ppo.e_clip, 0.2);
+    EXPECT_TRUE(fs::exists(c.spec_path)) << c.spec_path;
+  }
+}
+
+TEST(RunConfig, CommandLineOverridesTaskFileWhichOverridesDefaults) {
+  const RunConfig c = loadRunConfig(kConfigs, {"task=a1_beam", "method=SASA", "ppo.horizon=8",
+                                               "model.policy_hidden=[64, 32]", "seed=17", "env.target_speed=0.5"});
+  EXPECT_EQ(c.method, model::Method::kSasa);
+  EXPECT_EQ(c.ppo.horizon, 8);
+  EXPECT_EQ(c.model.policy_hidden, (std::vector<int>{64, 32}));
+  EXPECT_EQ(c.seed, 17u);
+  EXPECT_DOUBLE_EQ(c.env["target_speed"].as<double>(), 0.5);
+  EXPECT_EQ(c.origin.at("ppo.horizon"), "command line");
+  EXPECT_NE(c.origin.at("ppo.learning_rate").find("a1_beam.yaml"), std::string::npos);
+  EXPECT_NE(dumpResolved(c).find("horizon: 8"), std::string::npos);
+}
+
+TEST_F(ScratchConfigs, EnvSectionsMergeAcrossTaskFileAndCommandLine) {
+  writeTask("t", "env:\n  episode_steps: 100\n  weights: {alive: 2.0, velocity: 1.0}\n");
+  const RunConfig c = loadRunConfig(dir_.string(), {"task=t", "env.weights.alive=0.5"});
+  EXPECT_EQ(c.env["episode_steps"].as<int>(), 100);
+  EXPECT_DOUBLE_EQ(c.env["weights"]["alive"].as<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(c.env["weights"]["velocity"].as<double>(), 1.0);
+}
+
+TEST_F(ScratchConfigs, UnknownKeyInTaskFileNamesTheFileAndTheKey) {
+  const std::string file = writeTask("t", "ppo:\n  learning_rat: 0.1\n");
+  const ConfigError e = expectError({"task=t"});
+  EXPECT_EQ(e.file(), file);
+  EXPECT_EQ(e.key(), "ppo.learning_rat");
+  EXPECT_NE(std::string(e.what()).find("learning_rate"), std::string::npos) << "should list the known keys";
+}
+
+TEST_F(ScratchConfigs, UnknownKeyOnCommandLineNamesCommandLine) {
+  writeTask("t", "");
+  const ConfigError e = expectError({"task=t", "ppo.horizn=3"});
+  EXPECT_EQ(e.file(), "command line");
+  EXPECT_EQ(e.key(), "ppo.horizn");
+}
+
+TEST_F(ScratchConfigs, WrongTypeNamesWhereTheValueCameFrom) {
+  const std::string file = writeTask("t", "ppo:\n  horizon: lots\n");
+  const ConfigError e = expectError({"task=t"});
+  EXPECT_EQ(e.file(), file);
+  EXPECT_EQ(e.key(), "ppo.horizon");
+}
+
+TEST_F(ScratchConfigs, MapWhereAValueBelongsIsRejected) {
+  const std::string file = writeTask("t", "ppo:\n  gamma: {a: 1}\n");
+  EXPECT_EQ(expectError({"task=t"}).key(), "ppo.gamma");
+}
+
+TEST_F(ScratchConfigs, OutOfRangeValuesAreRejected) {
+  writeTask("t", "");
+  EXPECT_EQ(expectError({"task=t", "ppo.gamma=1.5"}).key(), "ppo.gamma");
+  EXPECT_EQ(expectError({"task=t", "ppo.learning_rate=-1"}).key(), "ppo.learning_rate");
+  EXPECT_EQ(expectError({"task=t", "ppo.mini_epochs=0"}).key(), "ppo.mini_epochs");
+  EXPECT_EQ(expectError({"task=t", "model.policy_hidden=[]"}).key(), "model.policy_hidden");
+  EXPECT_EQ(expectError({"task=t", "model.activation=swish"}).key(), "model.activation");
+  EXPECT_EQ(expectError({"task=t", "method=qmix"}).key(), "method");
+  EXPECT_EQ(expectError({"task=t", "ppo.lr_schedule=cosine"}).key(), "ppo.lr_schedule");
+}
+
+TEST_F(ScratchConfigs, UnknownTaskListsTheKnownOnes) {
+  writeTask("walker", "");
+  const ConfigError e = expectError({"task=runner"});
+  EXPECT_EQ(e.key(), "task");
+  EXPECT_NE(std::string(e.what()).find("walker"), std::string::npos) << e.what();
+}
+
+TEST_F(ScratchConfigs, MalformedYamlNamesFileAndLine) {
+  const std::string file = writeTask("t", "ppo:\n  horizon: [1, 2\n");
+  const ConfigError e = expectError({"task=t"});
+  EXPECT_EQ(e.file(), file);
+  EXPECT_NE(std::string(e.what()).find("line"), std::string::npos) << e.what();
+}
+
+TEST_F(ScratchConfigs, MalformedOverrideIsRejected) {
+  writeTask("t", "");
+  EXPECT_EQ(expectError({"task=t", "ppo.horizon"}).file(), "command line");
+}
+
+}  // namespace
+}  // namespace masa::config
