@@ -9,7 +9,8 @@ packages=(
   # core libraries
   libeigen3-dev libyaml-cpp-dev libcli11-dev libomp-dev
   # simulation
-  libmujoco-dev libmujoco-samples
+  # (mujoco's CMake config names the qhull headers, which libmujoco-dev does not pull in)
+  libmujoco-dev libqhull-dev libmujoco-samples
   # transport, tools and Java bindings (lcm-spy needs a JDK to build the types jar, and jchart2d)
   # (liblcm-dev needs glib headers but does not pull them in)
   liblcm-dev libglib2.0-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java

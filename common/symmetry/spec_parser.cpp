@@ -33,12 +33,13 @@ class Parser {
 
   ParsedSpec parse(const YAML::Node& root) {
     if (!root.IsMap()) fail("<document>", "expected a mapping with keys name, group, observation, action", root);
-    checkKeys(root, "", {"name", "group", "observation", "action"});
+    checkKeys(root, "", {"name", "group", "observation", "action", "mujoco"});
     ParsedSpec spec;
     spec.name = identifier(required(root, "", "name"), "name");
     spec.group = parseGroup(required(root, "", "group"));
     spec.observation = parseBlock(required(root, "", "observation"), "observation", spec.group);
     spec.action = parseBlock(required(root, "", "action"), "action", spec.group);
+    if (root["mujoco"].IsDefined()) spec.mujoco = parseMujoco(root["mujoco"], spec);
     return spec;
   }
 
@@ -90,6 +91,58 @@ class Parser {
       }
     }
     fail(key, "expected an integer" + (n.IsScalar() ? ", got '" + n.Scalar() + "'" : std::string()), n);
+  }
+
+  std::vector<std::string> nameList(const YAML::Node& n, const std::string& key, int expected) const {
+    if (!n.IsSequence()) fail(key, "expected a list of names", n);
+    if (static_cast<int>(n.size()) != expected)
+      fail(key, "has " + std::to_string(n.size()) + " names but the action layout has " + std::to_string(expected) +
+                    " entries here", n);
+    std::vector<std::string> names;
+    for (std::size_t k = 0; k < n.size(); ++k) names.push_back(scalar(n[k], key + "[" + std::to_string(k) + "]"));
+    return names;
+  }
+
+  MujocoBinding parseMujoco(const YAML::Node& n, const ParsedSpec& spec) const {
+    if (!n.IsMap()) fail("mujoco", "expected a mapping with keys actuators, free_joints", n);
+    checkKeys(n, "mujoco", {"actuators", "free_joints"});
+    MujocoBinding b;
+    b.present = true;
+    const YAML::Node act = required(n, "mujoco", "actuators");
+    if (!act.IsMap()) fail("mujoco.actuators", "expected a mapping with keys central, limbs", act);
+    checkKeys(act, "mujoco.actuators", {"central", "limbs"});
+    const int n_agents = spec.group.order;
+    if (act["central"].IsDefined())
+      b.central_actuators = nameList(act["central"], "mujoco.actuators.central", spec.action.centralDim());
+    else if (spec.action.centralDim() != 0)
+      fail("mujoco.actuators.central", "missing: the action layout has central entries", act);
+    const YAML::Node limbs = required(act, "mujoco.actuators", "limbs");
+    if (!limbs.IsSequence() || static_cast<int>(limbs.size()) != n_agents)
+      fail("mujoco.actuators.limbs", "expected one list of actuator names per limb (" + std::to_string(n_agents) + ")",
+           limbs);
+    for (int k = 0; k < n_agents; ++k)
+      b.limb_actuators.push_back(
+          nameList(limbs[k], "mujoco.actuators.limbs[" + std::to_string(k) + "]", spec.action.limbDim()));
+    if (n["free_joints"].IsDefined()) {
+      const YAML::Node fj = n["free_joints"];
+      if (!fj.IsSequence()) fail("mujoco.free_joints", "expected a list of {name, kind}", fj);
+      for (std::size_t k = 0; k < fj.size(); ++k) {
+        const std::string at = "mujoco.free_joints[" + std::to_string(k) + "]";
+        if (!fj[k].IsMap()) fail(at, "expected {name: ..., kind: robot_base|object}", fj[k]);
+        checkKeys(fj[k], at, {"name", "kind"});
+        FreeJoint j;
+        j.name = scalar(required(fj[k], at, "name"), at + ".name");
+        const std::string kind = scalar(required(fj[k], at, "kind"), at + ".kind");
+        if (kind == "robot_base")
+          j.kind = FreeJointKind::kRobotBase;
+        else if (kind == "object")
+          j.kind = FreeJointKind::kObject;
+        else
+          fail(at + ".kind", "unknown free joint kind '" + kind + "'; valid kinds: robot_base, object", fj[k]["kind"]);
+        b.free_joints.push_back(j);
+      }
+    }
+    return b;
   }
 
   Group parseGroup(const YAML::Node& n) const {

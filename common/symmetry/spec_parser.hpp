@@ -13,6 +13,7 @@ struct ParsedSpec {
   Group group;
   BlockLayout observation;
   BlockLayout action;
+  MujocoBinding mujoco;
 };
 
 // Entries come back with offsets set, and a swap_with pair names each other on both entries.

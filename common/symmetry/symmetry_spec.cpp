@@ -56,6 +56,7 @@ SymmetrySpec SymmetrySpec::parse(const YAML::Node& root, const std::string& sour
   spec.group_ = parsed.group;
   spec.obs_ = std::move(parsed.observation);
   spec.act_ = std::move(parsed.action);
+  spec.mujoco_ = std::move(parsed.mujoco);
   const int n = spec.numAgents();
   for (int i = 0; i < n; ++i) {
     spec.obs_t_.push_back(compileTransform(spec.obs_, spec.group_, i));
@@ -70,6 +71,13 @@ SymmetrySpec SymmetrySpec::parse(const YAML::Node& root, const std::string& sour
 
 int SymmetrySpec::obsDim() const { return obs_.centralDim() + numAgents() * obs_.limbDim(); }
 int SymmetrySpec::actDim() const { return act_.centralDim() + numAgents() * act_.limbDim(); }
+
+std::vector<std::string> SymmetrySpec::actuatorsInActionOrder() const {
+  if (!mujoco_.present) throw ConfigError(source_, "mujoco", "this spec has no mujoco section binding actions to actuators");
+  std::vector<std::string> names = mujoco_.central_actuators;
+  for (const auto& limb : mujoco_.limb_actuators) names.insert(names.end(), limb.begin(), limb.end());
+  return names;
+}
 
 const SparseMap& SymmetrySpec::obsTransform(int i) const {
   MASA_CHECK(i >= 0 && i < numAgents(), "agent " << i << " outside [0, " << numAgents() << ")");

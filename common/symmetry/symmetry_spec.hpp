@@ -78,6 +78,27 @@ struct BlockLayout {
   int limbDim() const;
 };
 
+// Optional tie to a MuJoCo model (spec key `mujoco`): which actuator each action drives, and how
+// the model's free joints move under the group. The tasks map actions to actuators with it and the
+// physics verifier transforms whole simulator states with it (hinge joints follow their actuator's
+// action entry: same permutation, same sign).
+enum class FreeJointKind {
+  kRobotBase,  // floating base whose limbs are relabelled: orientation g R g^-1 (mirror: M R M)
+  kObject,     // rigid object carried along: orientation g R (mirror: M R M, needs a mirror-symmetric object)
+};
+
+struct FreeJoint {
+  std::string name;
+  FreeJointKind kind = FreeJointKind::kObject;
+};
+
+struct MujocoBinding {
+  bool present = false;
+  std::vector<std::string> central_actuators;             // action order
+  std::vector<std::vector<std::string>> limb_actuators;   // [limb][slot], action order
+  std::vector<FreeJoint> free_joints;
+};
+
 struct Group {
   GroupType type = GroupType::kReflection;
   Axis axis = Axis::kY;
@@ -120,6 +141,11 @@ class SymmetrySpec {
   const std::vector<std::string>& obsNames() const { return obs_names_; }
   const std::vector<std::string>& actNames() const { return act_names_; }
 
+  const MujocoBinding& mujoco() const { return mujoco_; }
+  // Actuator names in action order (central, then limb 0, limb 1, ...); throws if no binding.
+  std::vector<std::string> actuatorsInActionOrder() const;
+  const std::string& source() const { return source_; }
+
  private:
   std::string name_;
   std::string source_;
@@ -128,6 +154,7 @@ class SymmetrySpec {
   std::vector<SparseMap> obs_t_, act_t_;
   std::vector<int> obs_classes_, act_classes_;
   std::vector<std::string> obs_names_, act_names_;
+  MujocoBinding mujoco_;
 };
 
 }  // namespace masa::sym

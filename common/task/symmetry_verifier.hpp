@@ -1,0 +1,51 @@
+// Physics-symmetry verifier: proves (or refutes) a symmetry spec against the simulation.
+//
+// For random valid states s (reset, then a random number of random-action steps) and random
+// actions a, and every group element i:
+//   observation map:  obs(T_i s) = T_i obs(s)                     (the observation is equivariant)
+//   dynamics:         step(T_i s, T_i a) = T_i step(s, a)          (per joint: qpos and qvel)
+//   reward:           r(T_i s, T_i a) = r(s, a), same termination
+// and reports the worst error per observation entry and per joint, so a wrong sign or a swapped
+// limb is named. Free-joint orientations are compared as rotations (q and -q are equal).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/task/registry.hpp"
+
+namespace masa::task {
+
+struct SymmetryVerifierOptions {
+  int num_states = 20;
+  int max_warmup_steps = 60;  // random-action steps from reset before a state is used
+  int steps = 1;              // steps compared from each state
+  std::uint64_t seed = 0;
+  double tolerance = 1e-6;    // pass threshold on every reported error (see docs/verifier.md)
+};
+
+struct NamedError {
+  std::string name;
+  double error = 0.0;
+};
+
+struct SymmetryReport {
+  // Observation errors are relative, |got - want| / (1 + |want|) (observations are floats);
+  // joint errors are absolute, in the joint's units (m, rad, m/s, rad/s).
+  std::vector<NamedError> observation_map;  // per observation dimension: obs(T s) vs T obs(s)
+  std::vector<NamedError> observation;      // per observation dimension after the step(s)
+  std::vector<NamedError> joints;           // per MuJoCo joint after the step(s) (qpos and qvel)
+  double reward_error = 0.0;
+  int termination_mismatches = 0;
+  double tolerance = 0.0;
+
+  double worst() const;
+  bool passed() const { return worst() <= tolerance && termination_mismatches == 0; }
+  // Human-readable: verdict, then the k worst observation entries and joints.
+  std::string summary(int top_k = 5) const;
+};
+
+SymmetryReport verifySymmetry(const TaskFactory& factory, const SymmetryVerifierOptions& options = {});
+
+}  // namespace masa::task

@@ -1,0 +1,239 @@
+#include "common/task/task.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "common/core/check.hpp"
+#include "common/symmetry/group_element.hpp"
+
+namespace masa::task {
+
+Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::SymmetrySpec spec, EnvParams& params,
+           const std::vector<std::pair<std::string, double>>& terms_with_default_weights)
+    : model_(std::move(model)), name_(std::move(name)), spec_(std::move(spec)) {
+  frame_skip_ = params.integer("frame_skip", 5, 1);
+  max_episode_steps_ = params.integer("max_episode_steps", 1000, 1);
+  termination_reward_ = params.number("termination_reward", -1.0);
+  for (const auto& [term, w] : terms_with_default_weights) {
+    term_names_.push_back(term);
+    weights_.push_back(params.weight(term, w));
+  }
+  term_names_.push_back("termination");
+  terms_.assign(term_names_.size(), 0.0);
+  raw_terms_.assign(term_names_.size(), 0.0);
+  data_ = mj_makeData(model_->get());
+  bindActuators();
+  last_action_.assign(actDim(), 0.0);
+  action_scratch_.assign(actDim(), 0.0);
+  qpos_scratch_.assign(model_->get()->nq, 0.0);
+  qvel_scratch_.assign(model_->get()->nv, 0.0);
+  ctrl_scratch_.assign(model_->get()->nu, 0.0);
+  episode_.term_sums.assign(term_names_.size(), 0.0);
+}
+
+Task::~Task() { mj_deleteData(data_); }
+
+void Task::bindActuators() {
+  const mjModel* m = model_->get();
+  const std::vector<std::string> names = spec_.actuatorsInActionOrder();
+  MASA_CHECK(static_cast<int>(names.size()) == actDim(), "spec binds " << names.size() << " actuators to " << actDim()
+                                                                       << " actions");
+  for (const std::string& n : names) {
+    const int a = model_->id(mjOBJ_ACTUATOR, n);
+    if (std::find(action_actuator_.begin(), action_actuator_.end(), a) != action_actuator_.end())
+      throw std::runtime_error(spec_.source() + ": actuator '" + n + "' is bound to two actions");
+    action_actuator_.push_back(a);
+    action_joint_.push_back(m->actuator_trntype[a] == mjTRN_JOINT ? m->actuator_trnid[2 * a] : -1);
+  }
+}
+
+double Task::controlTimestep() const { return frame_skip_ * model_->get()->opt.timestep; }
+
+void Task::reset(Rng& rng) {
+  mj_resetData(model_->get(), data_);
+  std::fill(last_action_.begin(), last_action_.end(), 0.0);
+  resetTask(rng);
+  mj_forward(model_->get(), data_);
+  episode_.ret = 0.0;
+  episode_.length = 0;
+  std::fill(episode_.term_sums.begin(), episode_.term_sums.end(), 0.0);
+  episode_.has_success = hasSuccessMeasure();
+  episode_.success = false;
+  episode_.terminated = episode_.truncated = false;
+}
+
+void Task::observe(float* out) const { writeObservation(out); }
+
+void Task::applyAction(const double* action) {
+  const mjModel* m = model_->get();
+  for (int k = 0; k < actDim(); ++k) {
+    const int a = action_actuator_[k];
+    if (m->actuator_ctrllimited[a]) {
+      const double lo = m->actuator_ctrlrange[2 * a], hi = m->actuator_ctrlrange[2 * a + 1];
+      data_->ctrl[a] = 0.5 * (lo + hi) + 0.5 * (hi - lo) * action[k];
+    } else {
+      data_->ctrl[a] = action[k];
+    }
+  }
+}
+
+StepOutcome Task::step(std::span<const float> action) {
+  if (static_cast<int>(action.size()) != actDim())
+    throw std::invalid_argument("task " + name_ + ": action has " + std::to_string(action.size()) +
+                                " values, expected " + std::to_string(actDim()));
+  return step(action.data());
+}
+
+StepOutcome Task::step(const float* action) {
+  const mjModel* m = model_->get();
+  for (int k = 0; k < actDim(); ++k) {
+    const double a = static_cast<double>(action[k]);
+    // NaN actions become 0: a policy bug must not poison the simulator state.
+    action_scratch_[k] = std::isfinite(a) ? std::clamp(a, -1.0, 1.0) : 0.0;
+  }
+  last_action_ = action_scratch_;
+  applyAction(action_scratch_.data());
+  const int bad_before = data_->warning[mjWARN_BADQACC].number;
+  for (int s = 0; s < frame_skip_; ++s) {
+    beforeSubstep();
+    mj_step(m, data_);
+  }
+  afterStep();
+  // MuJoCo resets the state itself after a divergence; such a step ends the episode.
+  const bool diverged = data_->warning[mjWARN_BADQACC].number != bad_before;
+
+  StepOutcome out;
+  out.terminated = diverged || isTerminated();
+  const int nterms = static_cast<int>(term_names_.size());
+  if (out.terminated) {
+    std::fill(terms_.begin(), terms_.end(), 0.0);
+    terms_[nterms - 1] = termination_reward_;
+    out.reward = termination_reward_;
+  } else {
+    computeRewardTerms(raw_terms_.data());
+    out.reward = 0.0;
+    for (int k = 0; k < nterms - 1; ++k) {
+      terms_[k] = weights_[k] * raw_terms_[k];
+      out.reward += terms_[k];
+    }
+    terms_[nterms - 1] = 0.0;
+  }
+  ++episode_.length;
+  out.truncated = !out.terminated && episode_.length >= max_episode_steps_;
+  episode_.ret += out.reward;
+  for (int k = 0; k < nterms; ++k) episode_.term_sums[k] += terms_[k];
+  episode_.terminated = out.terminated;
+  episode_.truncated = out.truncated;
+  if (episode_.has_success) episode_.success = isSuccess();
+  return out;
+}
+
+double Task::jointPower() const {
+  double p = 0.0;
+  for (int k = 0; k < actDim(); ++k) {
+    const int a = action_actuator_[k];
+    p += std::abs(data_->actuator_force[a] * data_->actuator_velocity[a]);
+  }
+  return p;
+}
+
+// Hinge and slide joints follow their actuator's action entry (a signed permutation); free joints
+// follow their kind; any other joint makes the state transform undefined and is reported by name.
+void Task::transformJoints(int i) {
+  const mjModel* m = model_->get();
+  const sym::SparseMap& t = spec_.actTransform(i);
+  std::vector<char> covered(m->njnt, 0);
+  std::copy(data_->qpos, data_->qpos + m->nq, qpos_scratch_.begin());
+  std::copy(data_->qvel, data_->qvel + m->nv, qvel_scratch_.begin());
+  std::copy(data_->ctrl, data_->ctrl + m->nu, ctrl_scratch_.begin());
+  std::vector<double> warm(data_->qacc_warmstart, data_->qacc_warmstart + m->nv);
+
+  for (int r = 0; r < t.rows(); ++r) {
+    const int begin = t.rowStart()[r], end = t.rowStart()[r + 1];
+    if (end - begin != 1 || std::abs(std::abs(t.values()[begin]) - 1.0) > 1e-12)
+      throw std::runtime_error(spec_.source() + ": action '" + spec_.actNames()[r] +
+                               "' is not a signed permutation of actions, so its joint cannot be mapped");
+    const int c = t.colIndex()[begin];
+    const double s = t.values()[begin];
+    const int jr = action_joint_[r], jc = action_joint_[c];
+    if (jr < 0 || jc < 0) throw std::runtime_error(spec_.source() + ": action '" + spec_.actNames()[r] + "' drives no joint");
+    if (m->jnt_type[jr] != mjJNT_HINGE && m->jnt_type[jr] != mjJNT_SLIDE)
+      throw std::runtime_error(model_->path() + ": actuated joint '" + std::string(mj_id2name(m, mjOBJ_JOINT, jr)) +
+                               "' is not a hinge or slide joint");
+    data_->qpos[m->jnt_qposadr[jr]] = s * qpos_scratch_[m->jnt_qposadr[jc]];
+    data_->qvel[m->jnt_dofadr[jr]] = s * qvel_scratch_[m->jnt_dofadr[jc]];
+    data_->qacc_warmstart[m->jnt_dofadr[jr]] = s * warm[m->jnt_dofadr[jc]];
+    data_->ctrl[action_actuator_[r]] = s * ctrl_scratch_[action_actuator_[c]];
+    covered[jr] = 1;
+  }
+
+  const Eigen::Matrix3d g = sym::spatialMap(spec_.group(), i);
+  const bool mirror = sym::isMirror(spec_.group(), i);
+  const Eigen::Quaterniond pq = sym::rotationQuaternion(spec_.group(), i);
+  for (const auto& fj : spec_.mujoco().free_joints) {
+    const int j = model_->id(mjOBJ_JOINT, fj.name);
+    if (m->jnt_type[j] != mjJNT_FREE)
+      throw std::runtime_error(model_->path() + ": joint '" + fj.name + "' is listed as a free joint but is not one");
+    covered[j] = 1;
+    double* qp = data_->qpos + m->jnt_qposadr[j];
+    double* qv = data_->qvel + m->jnt_dofadr[j];
+    double* qw = data_->qacc_warmstart + m->jnt_dofadr[j];
+    Eigen::Map<Eigen::Vector3d> pos(qp), lin(qv), ang(qv + 3), wlin(qw), wang(qw + 3);
+    pos = g * Eigen::Vector3d(pos);
+    lin = g * Eigen::Vector3d(lin);
+    wlin = g * Eigen::Vector3d(wlin);
+    Eigen::Quaterniond q(qp[3], qp[4], qp[5], qp[6]);
+    // Angular velocity of a free joint is in the body frame: see task.hpp and docs.
+    if (mirror) {
+      const Eigen::Vector3d v = -(g * q.vec());
+      q = Eigen::Quaterniond(q.w(), v.x(), v.y(), v.z());
+      ang = -(g * Eigen::Vector3d(ang));
+      wang = -(g * Eigen::Vector3d(wang));
+    } else if (fj.kind == sym::FreeJointKind::kRobotBase) {
+      q = pq * q * pq.conjugate();
+      ang = g * Eigen::Vector3d(ang);
+      wang = g * Eigen::Vector3d(wang);
+    } else {
+      q = pq * q;  // a carried object: its body-frame angular velocity is unchanged
+    }
+    qp[3] = q.w();
+    qp[4] = q.x();
+    qp[5] = q.y();
+    qp[6] = q.z();
+  }
+  for (int j = 0; j < m->njnt; ++j)
+    if (!covered[j])
+      throw std::runtime_error(spec_.source() + ": joint '" + std::string(mj_id2name(m, mjOBJ_JOINT, j)) +
+                               "' is neither driven by a bound actuator nor listed in mujoco.free_joints");
+}
+
+void Task::applySymmetry(int i) {
+  MASA_CHECK(i >= 0 && i < spec_.numAgents(), "group element " << i << " out of range");
+  if (i == 0) return;
+  transformJoints(i);
+  const sym::SparseMap& t = spec_.actTransform(i);
+  Eigen::Map<const Eigen::VectorXd> a(last_action_.data(), actDim());
+  Eigen::VectorXd ta(actDim());
+  t.apply<double>(a, ta);
+  std::copy(ta.data(), ta.data() + actDim(), last_action_.begin());
+  transformExtras(i);
+  mj_forward(model_->get(), data_);
+}
+
+void Task::copyStateFrom(const Task& other) {
+  MASA_CHECK(other.name_ == name_ && other.model()->nq == model()->nq, "copyStateFrom needs the same task");
+  const mjModel* m = model_->get();
+  data_->time = other.data_->time;
+  std::copy(other.data_->qpos, other.data_->qpos + m->nq, data_->qpos);
+  std::copy(other.data_->qvel, other.data_->qvel + m->nv, data_->qvel);
+  std::copy(other.data_->act, other.data_->act + m->na, data_->act);
+  std::copy(other.data_->ctrl, other.data_->ctrl + m->nu, data_->ctrl);
+  std::copy(other.data_->qacc_warmstart, other.data_->qacc_warmstart + m->nv, data_->qacc_warmstart);
+  last_action_ = other.last_action_;
+  episode_ = other.episode_;
+  copyExtrasFrom(other);
+  mj_forward(m, data_);
+}
+
+}  // namespace masa::task

@@ -1,0 +1,129 @@
+// A robot task simulated in MuJoCo: reset from a passed-in generator, step with frame skip and
+// clamped controls, observation in the symmetry spec's layout, reward term by term, termination
+// kept apart from time-limit truncation, and episode statistics.
+//
+// A concrete task (one folder per task under tasks/) fills in the hooks below; everything common
+// lives here, including applying a symmetry T_i to the WHOLE task state (MuJoCo joints through
+// the spec's `mujoco` binding, the last action, and the task's own extras such as a goal pose),
+// which the physics verifier uses.
+//
+// Actions arrive in [-1, 1] in the spec's action order; the task maps them to actuators (by the
+// spec's actuator names) and scales them. Nothing here allocates after construction.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "common/core/types.hpp"
+#include "common/symmetry/symmetry_spec.hpp"
+#include "common/task/env_params.hpp"
+#include "common/task/mujoco_model.hpp"
+
+namespace masa::task {
+
+struct StepOutcome {
+  double reward = 0.0;
+  bool terminated = false;  // the episode failed or ended for good: no value bootstrap
+  bool truncated = false;   // time limit reached: bootstrap from the final observation
+};
+
+struct EpisodeStats {
+  double ret = 0.0;
+  int length = 0;
+  std::vector<double> term_sums;  // per reward term, weighted, in rewardTermNames() order
+  bool has_success = false;
+  bool success = false;
+  bool terminated = false;
+  bool truncated = false;
+};
+
+class Task {
+ public:
+  virtual ~Task();
+  Task(const Task&) = delete;
+  Task& operator=(const Task&) = delete;
+
+  const std::string& name() const { return name_; }
+  int obsDim() const { return spec_.obsDim(); }
+  int actDim() const { return spec_.actDim(); }
+  const sym::SymmetrySpec& spec() const { return spec_; }
+  double controlTimestep() const;  // seconds per step(): frame_skip * model timestep
+  int maxEpisodeSteps() const { return max_episode_steps_; }
+
+  // Reward terms: the task's terms (weighted by env.weights.<term>), then "termination".
+  const std::vector<std::string>& rewardTermNames() const { return term_names_; }
+  const std::vector<double>& rewardTerms() const { return terms_; }  // last step, weighted
+
+  void reset(Rng& rng);
+  void observe(float* out) const;             // obsDim() values
+  StepOutcome step(const float* action);      // actDim() values, clamped to [-1, 1]
+  StepOutcome step(std::span<const float> action);  // the same, checking the size
+  const EpisodeStats& episode() const { return episode_; }
+
+  // Whole-state symmetry: the state becomes T_i of itself (then mj_forward). The verifier compares
+  // step(T s, T a) with T step(s, a).
+  void applySymmetry(int i);
+  // Copies the full state (simulator and task extras) of another instance of the same task.
+  void copyStateFrom(const Task& other);
+
+  const mjModel* model() const { return model_->get(); }
+  const mjData* data() const { return data_; }
+  mjData* data() { return data_; }
+  const std::vector<double>& lastAction() const { return last_action_; }  // clamped, action order
+
+ protected:
+  // `term_names` are the task's reward terms; their weights come from env.weights.<term>.
+  Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::SymmetrySpec spec, EnvParams& params,
+       const std::vector<std::pair<std::string, double>>& terms_with_default_weights);
+
+  // --- hooks ---
+  // Called after mj_resetData: set the initial state (and task extras) from rng. mj_forward follows.
+  virtual void resetTask(Rng& rng) = 0;
+  virtual void writeObservation(float* out) const = 0;
+  // Unweighted value of each reward term after a step (the base class applies the weights).
+  virtual void computeRewardTerms(double* raw_terms) const = 0;
+  virtual bool isTerminated() const = 0;
+  // Sets data()->ctrl from the clamped action (action order). Default: ctrl = action scaled into
+  // each actuator's ctrlrange midpoint +- half-range (i.e. [-1,1] maps onto ctrlrange).
+  virtual void applyAction(const double* action);
+  // Called before every physics substep (PD loops compute torques here).
+  virtual void beforeSubstep() {}
+  // Called after the substeps of a step, before reward and termination (e.g. route re-anchoring).
+  virtual void afterStep() {}
+  virtual bool hasSuccessMeasure() const { return false; }
+  virtual bool isSuccess() const { return false; }
+  // Task-owned state beyond qpos/qvel/ctrl/last action (a goal pose, a route) under T_i, and copies.
+  virtual void transformExtras(int i) {}
+  virtual void copyExtrasFrom(const Task& other) {}
+
+  // --- helpers for tasks ---
+  int actuatorOfAction(int k) const { return action_actuator_[k]; }
+  int jointOfAction(int k) const { return action_joint_[k]; }
+  int frameSkip() const { return frame_skip_; }
+  // Sum over actuated joints of |actuator force * joint velocity| (W): the paper's energy term.
+  double jointPower() const;
+
+  std::shared_ptr<const MujocoModel> model_;
+  mjData* data_ = nullptr;
+
+ private:
+  void bindActuators();
+  void transformJoints(int i);
+
+  std::string name_;
+  sym::SymmetrySpec spec_;
+  int frame_skip_;
+  int max_episode_steps_;
+  double termination_reward_;
+  std::vector<std::string> term_names_;
+  std::vector<double> weights_;
+  std::vector<double> terms_, raw_terms_;
+  std::vector<int> action_actuator_, action_joint_;
+  std::vector<double> last_action_, action_scratch_;
+  std::vector<double> qpos_scratch_, qvel_scratch_, ctrl_scratch_;
+  EpisodeStats episode_;
+};
+
+}  // namespace masa::task
