@@ -1,0 +1,85 @@
+#include "common/render/offscreen_renderer.hpp"
+
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+
+namespace masa::render {
+
+OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height) : model_(model) {
+  if (!glfwInit())
+    throw std::runtime_error(
+        "cannot initialise GLFW for offscreen rendering (no display?): run the command under `xvfb-run -a`");
+  glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);
+  GLFWwindow* w = glfwCreateWindow(64, 64, "masa", nullptr, nullptr);
+  if (!w) {
+    glfwTerminate();
+    throw std::runtime_error("cannot create an OpenGL context: run the command under `xvfb-run -a`");
+  }
+  window_ = w;
+  glfwMakeContextCurrent(w);
+  mjv_defaultScene(&scene_);
+  mjv_defaultCamera(&camera_);
+  mjv_defaultOption(&option_);
+  mjr_defaultContext(&context_);
+  mjv_makeScene(model, &scene_, 4000);
+  mjr_makeContext(model, &context_, mjFONTSCALE_100);
+  mjr_setBuffer(mjFB_OFFSCREEN, &context_);
+  // The offscreen buffer's size is set by the model (visual/global offwidth, offheight).
+  width_ = std::min(width, context_.offWidth);
+  height_ = std::min(height, context_.offHeight);
+  rgb_.resize(static_cast<size_t>(width_) * height_ * 3);
+  flipped_.resize(rgb_.size());
+}
+
+OffscreenRenderer::~OffscreenRenderer() {
+  mjr_freeContext(&context_);
+  mjv_freeScene(&scene_);
+  glfwDestroyWindow(static_cast<GLFWwindow*>(window_));
+  glfwTerminate();
+}
+
+void OffscreenRenderer::trackBody(int body, double distance, double azimuth_deg, double elevation_deg) {
+  camera_.type = mjCAMERA_TRACKING;
+  camera_.trackbodyid = body;
+  camera_.distance = distance;
+  camera_.azimuth = azimuth_deg;
+  camera_.elevation = elevation_deg;
+}
+
+const std::vector<unsigned char>& OffscreenRenderer::render(const mjData* data) {
+  mjrRect viewport{0, 0, width_, height_};
+  mjv_updateScene(model_, const_cast<mjData*>(data), &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
+  mjr_render(viewport, &scene_, &context_);
+  mjr_readPixels(rgb_.data(), nullptr, viewport, &context_);
+  // OpenGL rows start at the bottom.
+  const size_t row = static_cast<size_t>(width_) * 3;
+  for (int y = 0; y < height_; ++y)
+    std::memcpy(flipped_.data() + y * row, rgb_.data() + (height_ - 1 - y) * row, row);
+  return flipped_;
+}
+
+FrameWriter::FrameWriter(const std::string& path, int width, int height, double fps, int strip_frames)
+    : path_(path), strip_(path.size() > 4 && path.substr(path.size() - 4) == ".png"), strip_frames_(strip_frames) {
+  std::string filter = strip_ ? "-vf tile=" + std::to_string(strip_frames) + "x1 -frames:v 1 -update 1"
+                              : (path.size() > 4 && path.substr(path.size() - 4) == ".gif" ? "" : "-pix_fmt yuv420p");
+  const std::string cmd = "ffmpeg -y -loglevel error -f rawvideo -pixel_format rgb24 -video_size " +
+                          std::to_string(width) + "x" + std::to_string(height) + " -framerate " + std::to_string(fps) +
+                          " -i - " + filter + " '" + path + "'";
+  pipe_ = popen(cmd.c_str(), "w");
+  if (!pipe_) throw std::runtime_error("cannot start ffmpeg (is the ffmpeg package installed?)");
+}
+
+FrameWriter::~FrameWriter() {
+  if (pipe_) pclose(pipe_);
+}
+
+void FrameWriter::write(const std::vector<unsigned char>& rgb) {
+  if (std::fwrite(rgb.data(), 1, rgb.size(), pipe_) != rgb.size())
+    throw std::runtime_error("ffmpeg stopped taking frames for " + path_);
+}
+
+}  // namespace masa::render
