@@ -10,7 +10,11 @@ Eigen::Quaterniond rotationQuaternion(const Group& group, int i) {
   if (group.type == GroupType::kReflection) return Eigen::Quaterniond::Identity();
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();
   axis(static_cast<int>(group.axis)) = 1.0;
-  const double angle = -2.0 * M_PI * static_cast<double>(i % group.order) / group.order;
+  // Odd N: the lifted angle -2 pi i (N+1)/N, the same rotation but with p^N = +1, so that a
+  // carried object's stored quaternion equals what the spec's `quaternion` kind predicts (not its
+  // negative). Even N has no such lift; conjugation (robot bases) does not see the sign.
+  const int n = group.order, k = i % n;
+  const double angle = (n % 2 == 1) ? -2.0 * M_PI * k * (n + 1) / n : -2.0 * M_PI * k / n;
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis));
 }
 

@@ -12,7 +12,8 @@ namespace masa::sym {
 Eigen::Matrix3d spatialMap(const Group& group, int i);
 // True when element i reverses orientation (a mirror).
 bool isMirror(const Group& group, int i);
-// Rotation part as a quaternion (identity for a mirror element).
+// Rotation part as a quaternion (identity for a mirror element); for odd N the lifted one that the
+// spec's `quaternion` kind uses.
 Eigen::Quaterniond rotationQuaternion(const Group& group, int i);
 
 }  // namespace masa::sym

@@ -15,6 +15,7 @@ Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::Symm
   frame_skip_ = params.integer("frame_skip", 5, 1);
   max_episode_steps_ = params.integer("max_episode_steps", 1000, 1);
   termination_reward_ = params.number("termination_reward", -1.0);
+  energy_velocity_scale_ = params.number("energy_velocity_scale", 0.2);
   for (const auto& [term, w] : terms_with_default_weights) {
     term_names_.push_back(term);
     weights_.push_back(params.weight(term, w));
@@ -99,6 +100,10 @@ StepOutcome Task::step(const float* action) {
     beforeSubstep();
     mj_step(m, data_);
   }
+  // mj_step leaves body poses at the start of its last substep: observations, rewards and
+  // terminations must see the state the step ended in (the symmetry verifier compares exactly that).
+  mj_kinematics(m, data_);
+  mj_comPos(m, data_);
   afterStep();
   // MuJoCo resets the state itself after a divergence; such a step ends the episode.
   const bool diverged = data_->warning[mjWARN_BADQACC].number != bad_before;
@@ -130,12 +135,13 @@ StepOutcome Task::step(const float* action) {
 }
 
 double Task::jointPower() const {
+  const mjModel* m = model_->get();
   double p = 0.0;
   for (int k = 0; k < actDim(); ++k) {
-    const int a = action_actuator_[k];
-    p += std::abs(data_->actuator_force[a] * data_->actuator_velocity[a]);
+    const int j = action_joint_[k];
+    if (j >= 0) p += std::abs(last_action_[k] * data_->qvel[m->jnt_dofadr[j]]);
   }
-  return p;
+  return p * energy_velocity_scale_;
 }
 
 // Hinge and slide joints follow their actuator's action entry (a signed permutation); free joints

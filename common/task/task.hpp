@@ -91,6 +91,8 @@ class Task {
   // Called before every physics substep (PD loops compute torques here).
   virtual void beforeSubstep() {}
   // Called after the substeps of a step, before reward and termination (e.g. route re-anchoring).
+  // Body and geom poses (xpos, xmat, geom_xpos, ...) are refreshed for the final state before this
+  // hook; velocity-derived quantities (cvel, actuator_velocity) are those of the last substep.
   virtual void afterStep() {}
   virtual bool hasSuccessMeasure() const { return false; }
   virtual bool isSuccess() const { return false; }
@@ -102,7 +104,10 @@ class Task {
   int actuatorOfAction(int k) const { return action_actuator_[k]; }
   int jointOfAction(int k) const { return action_joint_[k]; }
   int frameSkip() const { return frame_skip_; }
-  // Sum over actuated joints of |actuator force * joint velocity| (W): the paper's energy term.
+  // The paper's "joints power consumption" in the convention its weights were tuned for
+  // (IsaacGym's electricity cost): sum over actions of |a_k * qdot_k| * energy_velocity_scale, with
+  // a_k the clamped action in [-1, 1] and qdot_k its joint's velocity (rad/s). Physical power
+  // |torque * qdot| would be gear times larger and swamp the other terms at the paper's weights.
   double jointPower() const;
 
   std::shared_ptr<const MujocoModel> model_;
@@ -117,6 +122,7 @@ class Task {
   int frame_skip_;
   int max_episode_steps_;
   double termination_reward_;
+  double energy_velocity_scale_;
   std::vector<std::string> term_names_;
   std::vector<double> weights_;
   std::vector<double> terms_, raw_terms_;
