@@ -1,0 +1,234 @@
+// TriFinger Lift: three fingers move a cube to a random 6-DoF goal pose (see README.md).
+//
+// Actions are joint position targets tracked by a PD loop at the physics rate; the reward is the
+// public IsaacGymEnvs one without its finger-movement penalty (as in the paper): a keypoint kernel
+// over the 8 cube corners and a fingertip-approach term. The goal pose is task-owned state that
+// applySymmetry rotates together with the world.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "common/core/check.hpp"
+#include "common/symmetry/group_element.hpp"
+#include "common/task/registry.hpp"
+
+namespace masa::task {
+namespace {
+
+constexpr int kFingers = 3;
+constexpr int kJoints = 9;
+
+class TrifingerLift final : public Task {
+ public:
+  TrifingerLift(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec, EnvParams& p)
+      : Task("trifinger_lift", std::move(model), spec, p, {{"keypoints", 40.0}, {"reach", -15.0}}) {
+    kp_ = p.positive("kp", 10.0);
+    kd_ = p.number("kd", 0.2);
+    max_velocity_ = p.positive("max_joint_velocity", 10.0);
+    keypoint_scale_ = p.positive("keypoint_scale", 30.0);
+    joint_noise_ = p.number("init_joint_noise", 0.05);
+    cube_init_radius_ = p.number("cube_init_radius", 0.08);
+    goal_radius_ = p.number("goal_radius", 0.10);
+    goal_max_height_ = p.positive("goal_max_height", 0.10);
+    success_pos_tol_ = p.positive("success_position_tolerance", 0.02);
+    success_rot_tol_ = p.positive("success_orientation_tolerance", 0.4);
+
+    const mjModel* m = model_->get();
+    cube_qpos_ = m->jnt_qposadr[model_->id(mjOBJ_JOINT, "cube")];
+    const int cube_geom = model_->id(mjOBJ_GEOM, "cube");
+    cube_half_ = m->geom_size[3 * cube_geom];
+    for (int f = 0; f < kFingers; ++f) tip_geom_[f] = model_->id(mjOBJ_GEOM, "finger" + std::to_string(f) + "_tip");
+    MASA_CHECK(actDim() == kJoints, "trifinger_lift needs 9 actions, the spec has " << actDim());
+    for (int k = 0; k < kJoints; ++k) {
+      const int j = jointOfAction(k);
+      MASA_CHECK(j >= 0 && m->jnt_limited[j], "action " << k << " must drive a limited joint");
+      qpos_adr_[k] = m->jnt_qposadr[j];
+      dof_adr_[k] = m->jnt_dofadr[j];
+      lo_[k] = m->jnt_range[2 * j];
+      hi_[k] = m->jnt_range[2 * j + 1];
+      const int a = actuatorOfAction(k);
+      torque_limit_[k] = m->actuator_ctrllimited[a] ? m->actuator_ctrlrange[2 * a + 1] : 1e9;
+    }
+    // Lifted yaw quaternions of the spec's `quaternion` kind: angle -2*pi*i*(N+1)/N (docs/symmetry_spec.md).
+    const int n = spec.numAgents();
+    for (int i = 0; i < n; ++i) {
+      const double half = -M_PI * i * (n + 1) / n;
+      lifted_.push_back(Eigen::Quaterniond(std::cos(half), 0.0, 0.0, std::sin(half)));
+    }
+  }
+
+ protected:
+  void resetTask(Rng& rng) override {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const double pose[3] = {0.0, 0.9, -1.7};  // TriFinger's default pose, per finger
+    for (int k = 0; k < kJoints; ++k) {
+      const double q = pose[k % 3] + joint_noise_ * (2.0 * unit(rng) - 1.0);
+      data_->qpos[qpos_adr_[k]] = std::clamp(q, lo_[k], hi_[k]);
+    }
+    // Cube resting flat on the table, random position in a disc and random yaw, redrawn while a
+    // fingertip (lowered by the joint noise) would start inside it.
+    mj_kinematics(model_->get(), data_);
+    double* c = data_->qpos + cube_qpos_;
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      const Eigen::Vector2d xy = sampleDisc(rng, cube_init_radius_);
+      const double yaw = 2.0 * M_PI * unit(rng);
+      c[0] = xy.x();
+      c[1] = xy.y();
+      // Sunk by its resting depth (~0.1 mm): exactly touching, the corners' contact test would hinge
+      // on rounding, which differs between a state and its rotated copy.
+      c[2] = cube_half_ - 1e-4;
+      c[3] = std::cos(0.5 * yaw);
+      c[4] = c[5] = 0.0;
+      c[6] = std::sin(0.5 * yaw);
+      if (tipsClearOfCube()) break;
+    }
+    // Goal: uniformly random orientation (Shoemake), centre in a disc, height between the lowest
+    // height at which that orientation clears the table and goal_max_height.
+    const double u1 = unit(rng), u2 = 2.0 * M_PI * unit(rng), u3 = 2.0 * M_PI * unit(rng);
+    goal_quat_ = Eigen::Quaterniond(std::sqrt(u1) * std::cos(u3), std::sqrt(1.0 - u1) * std::sin(u2),
+                                    std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3));
+    if (goal_quat_.w() < 0) goal_quat_.coeffs() *= -1.0;
+    const Eigen::Matrix3d r = goal_quat_.toRotationMatrix();
+    const double z_min = cube_half_ * (std::abs(r(2, 0)) + std::abs(r(2, 1)) + std::abs(r(2, 2)));
+    const Eigen::Vector2d gxy = sampleDisc(rng, goal_radius_);
+    goal_pos_ = Eigen::Vector3d(gxy.x(), gxy.y(), z_min + (std::max(goal_max_height_, z_min) - z_min) * unit(rng));
+  }
+
+  void writeObservation(float* out) const override {
+    const double* c = data_->qpos + cube_qpos_;
+    for (int d = 0; d < 7; ++d) out[d] = static_cast<float>(c[d]);
+    for (int d = 0; d < 3; ++d) out[7 + d] = static_cast<float>(goal_pos_(d));
+    out[10] = static_cast<float>(goal_quat_.w());
+    out[11] = static_cast<float>(goal_quat_.x());
+    out[12] = static_cast<float>(goal_quat_.y());
+    out[13] = static_cast<float>(goal_quat_.z());
+    const std::vector<double>& last = lastAction();
+    for (int f = 0; f < kFingers; ++f) {
+      float* o = out + 14 + 9 * f;
+      for (int j = 0; j < 3; ++j) {
+        const int k = 3 * f + j;
+        o[j] = static_cast<float>(data_->qpos[qpos_adr_[k]]);
+        o[3 + j] = static_cast<float>(data_->qvel[dof_adr_[k]]);
+        o[6 + j] = static_cast<float>(last[k]);
+      }
+    }
+  }
+
+  void applyAction(const double* action) override {
+    for (int k = 0; k < kJoints; ++k) q_target_[k] = 0.5 * (lo_[k] + hi_[k]) + 0.5 * (hi_[k] - lo_[k]) * action[k];
+    // Fingertip kinematics are current here (after reset, a step, a state copy or a symmetry).
+    prev_tip_distance_ = tipDistanceSum();
+  }
+
+  void beforeSubstep() override {
+    for (int k = 0; k < kJoints; ++k) {
+      const double qd = data_->qvel[dof_adr_[k]];
+      double tau = kp_ * (q_target_[k] - data_->qpos[qpos_adr_[k]]) - kd_ * qd;
+      // Speed limit of the motors: above it a motor only brakes.
+      if (qd > max_velocity_) tau = std::min(tau, 0.0);
+      if (qd < -max_velocity_) tau = std::max(tau, 0.0);
+      data_->ctrl[actuatorOfAction(k)] = std::clamp(tau, -torque_limit_[k], torque_limit_[k]);
+    }
+  }
+
+  // mj_step leaves positions of bodies one substep behind qpos; the reward needs current ones.
+  void afterStep() override { mj_kinematics(model_->get(), data_); }
+
+  void computeRewardTerms(double* raw) const override {
+    const Eigen::Vector3d cp(data_->qpos + cube_qpos_);
+    const double* c = data_->qpos + cube_qpos_;
+    const Eigen::Matrix3d rc = Eigen::Quaterniond(c[3], c[4], c[5], c[6]).normalized().toRotationMatrix();
+    const Eigen::Matrix3d rg = goal_quat_.toRotationMatrix();
+    double kernel = 0.0;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d local(corner & 1 ? cube_half_ : -cube_half_, corner & 2 ? cube_half_ : -cube_half_,
+                                  corner & 4 ? cube_half_ : -cube_half_);
+      const double d = ((cp + rc * local) - (goal_pos_ + rg * local)).norm();
+      kernel += 1.0 / (std::exp(keypoint_scale_ * d) + 2.0 + std::exp(-keypoint_scale_ * d));
+    }
+    raw[0] = kernel / 8.0;
+    raw[1] = tipDistanceSum() - prev_tip_distance_;
+  }
+
+  bool isTerminated() const override { return false; }
+  bool hasSuccessMeasure() const override { return true; }
+
+  bool isSuccess() const override {
+    const double* c = data_->qpos + cube_qpos_;
+    const Eigen::Quaterniond q = Eigen::Quaterniond(c[3], c[4], c[5], c[6]).normalized();
+    const double pos_err = (Eigen::Vector3d(c) - goal_pos_).norm();
+    const double rot_err = 2.0 * std::acos(std::min(1.0, std::abs(q.dot(goal_quat_))));
+    return pos_err <= success_pos_tol_ && rot_err <= success_rot_tol_;
+  }
+
+  void transformExtras(int i) override {
+    goal_pos_ = sym::spatialMap(spec().group(), i) * goal_pos_;
+    goal_quat_ = lifted_[i] * goal_quat_;
+    // The cube's orientation must follow the same lifted quaternion as the observation's
+    // `quaternion` kind; the base applies the unlifted rotation quaternion, which for some i is its
+    // negative (the same pose, but -q in the observation). Keep the spec's sign.
+    if (sym::rotationQuaternion(spec().group(), i).coeffs().dot(lifted_[i].coeffs()) < 0)
+      for (int d = 3; d < 7; ++d) data_->qpos[cube_qpos_ + d] = -data_->qpos[cube_qpos_ + d];
+  }
+
+  void copyExtrasFrom(const Task& other) override {
+    const auto& o = static_cast<const TrifingerLift&>(other);
+    goal_pos_ = o.goal_pos_;
+    goal_quat_ = o.goal_quat_;
+  }
+
+ private:
+  static Eigen::Vector2d sampleDisc(Rng& rng, double radius) {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const double r = radius * std::sqrt(unit(rng)), a = 2.0 * M_PI * unit(rng);
+    return {r * std::cos(a), r * std::sin(a)};
+  }
+
+  // True when every fingertip sphere is at least 1 mm away from the cube box (cube pose from qpos,
+  // fingertip positions from the last kinematics pass).
+  bool tipsClearOfCube() const {
+    const double* c = data_->qpos + cube_qpos_;
+    const Eigen::Quaterniond q(c[3], c[4], c[5], c[6]);
+    for (int f = 0; f < kFingers; ++f) {
+      const Eigen::Vector3d local =
+          q.conjugate() * (Eigen::Vector3d(data_->geom_xpos + 3 * tip_geom_[f]) - Eigen::Vector3d(c));
+      const Eigen::Vector3d outside = (local.cwiseAbs().array() - cube_half_).max(0.0).matrix();
+      if (outside.norm() < model_->get()->geom_size[3 * tip_geom_[f]] + 1e-3) return false;
+    }
+    return true;
+  }
+
+  double tipDistanceSum() const {
+    const Eigen::Vector3d cp(data_->qpos + cube_qpos_);
+    double s = 0.0;
+    for (int f = 0; f < kFingers; ++f) s += (Eigen::Vector3d(data_->geom_xpos + 3 * tip_geom_[f]) - cp).norm();
+    return s;
+  }
+
+  double kp_, kd_, max_velocity_, keypoint_scale_, joint_noise_, cube_init_radius_, goal_radius_, goal_max_height_;
+  double success_pos_tol_, success_rot_tol_;
+  int cube_qpos_ = 0;
+  double cube_half_ = 0.0;
+  std::array<int, kFingers> tip_geom_{};
+  std::array<int, kJoints> qpos_adr_{}, dof_adr_{};
+  std::array<double, kJoints> lo_{}, hi_{}, torque_limit_{}, q_target_{};
+  std::vector<Eigen::Quaterniond> lifted_;
+  Eigen::Vector3d goal_pos_ = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond goal_quat_ = Eigen::Quaterniond::Identity();
+  double prev_tip_distance_ = 0.0;
+};
+
+std::unique_ptr<Task> makeTrifingerLift(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
+                                        EnvParams& params) {
+  return std::make_unique<TrifingerLift>(std::move(model), spec, params);
+}
+
+}  // namespace
+
+MASA_REGISTER_TASK("trifinger_lift", "tasks/trifinger_lift/model.xml", &makeTrifingerLift);
+
+}  // namespace masa::task

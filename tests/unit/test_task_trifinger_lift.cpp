@@ -1,0 +1,238 @@
+// TriFinger Lift: loading, episode mechanics, reward terms and success on hand-made states,
+// determinism, the exact C3 symmetry of the scene, and the physics check of the symmetry spec.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "common/config/run_config.hpp"
+#include "common/task/registry.hpp"
+#include "common/task/symmetry_verifier.hpp"
+
+namespace masa::task {
+namespace {
+
+const std::string kSpec = std::string(MASA_SOURCE_DIR) + "/configs/specs/trifinger_lift.yaml";
+
+TaskFactory makeFactory(const sym::SymmetrySpec& spec) {
+  const config::RunConfig rc = config::loadRunConfig(MASA_SOURCE_DIR "/configs", {"task=trifinger_lift"});
+  return TaskFactory("trifinger_lift", spec, rc.env, rc.origin);
+}
+
+TaskFactory makeFactory() { return makeFactory(sym::SymmetrySpec::load(kSpec)); }
+
+int termIndex(const Task& t, const std::string& name) {
+  const auto& n = t.rewardTermNames();
+  const auto it = std::find(n.begin(), n.end(), name);
+  EXPECT_NE(it, n.end()) << name;
+  return static_cast<int>(it - n.begin());
+}
+
+double tipDistanceSum(const Task& t) {
+  const mjModel* m = t.model();
+  const Eigen::Vector3d cube(t.data()->qpos + m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "cube")]);
+  double s = 0.0;
+  for (int f = 0; f < 3; ++f) {
+    const int g = mj_name2id(m, mjOBJ_GEOM, ("finger" + std::to_string(f) + "_tip").c_str());
+    s += (Eigen::Vector3d(t.data()->geom_xpos + 3 * g) - cube).norm();
+  }
+  return s;
+}
+
+// Places the cube at the goal pose read from the observation (indices 7..13), shifted by `offset`.
+void putCubeAtGoal(Task& t, const Eigen::Vector3d& offset) {
+  std::vector<float> obs(t.obsDim());
+  t.observe(obs.data());
+  const mjModel* m = t.model();
+  const int j = mj_name2id(m, mjOBJ_JOINT, "cube");
+  double* q = t.data()->qpos + m->jnt_qposadr[j];
+  for (int d = 0; d < 3; ++d) q[d] = obs[7 + d] + offset(d);
+  for (int d = 0; d < 4; ++d) q[3 + d] = obs[10 + d];
+  std::fill(t.data()->qvel + m->jnt_dofadr[j], t.data()->qvel + m->jnt_dofadr[j] + 6, 0.0);
+  mj_forward(m, t.data());
+}
+
+TEST(TrifingerLift, LoadsAndRunsThousandRandomStepsWithFiniteValues) {
+  const TaskFactory f = makeFactory();
+  auto t = f.create();
+  ASSERT_EQ(t->obsDim(), 41);
+  ASSERT_EQ(t->actDim(), 9);
+  EXPECT_DOUBLE_EQ(t->controlTimestep(), 0.02);  // 50 Hz
+  EXPECT_EQ(t->maxEpisodeSteps(), 750);
+  Rng rng(1);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> obs(41), act(9);
+  t->reset(rng);
+  for (int s = 0; s < 1000; ++s) {
+    for (float& a : act) a = u(rng);
+    const StepOutcome o = t->step(act.data());
+    t->observe(obs.data());
+    ASSERT_TRUE(std::isfinite(o.reward)) << "step " << s;
+    for (int d = 0; d < 41; ++d) ASSERT_TRUE(std::isfinite(obs[d])) << "step " << s << " dim " << d;
+    ASSERT_FALSE(o.terminated) << "step " << s;  // only a divergence terminates
+    if (o.truncated) t->reset(rng);
+  }
+}
+
+TEST(TrifingerLift, FingersAndWallAreExactRotationsOfFingerZero) {
+  const TaskFactory f = makeFactory();
+  auto t = f.create();
+  const mjModel* m = t->model();
+  mjData* d = t->data();
+  const double pose[3] = {0.4, 0.7, -1.2};  // the same joint angles on every finger
+  const char* joints[3] = {"upper", "middle", "lower"};
+  for (int f = 0; f < 3; ++f)
+    for (int j = 0; j < 3; ++j) {
+      const std::string name = "finger" + std::to_string(f) + "_" + joints[j];
+      d->qpos[m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, name.c_str())]] = pose[j];
+    }
+  mj_forward(m, d);
+  const int tip0 = mj_name2id(m, mjOBJ_GEOM, "finger0_tip");
+  for (int f = 1; f < 3; ++f) {
+    const int tip = mj_name2id(m, mjOBJ_GEOM, ("finger" + std::to_string(f) + "_tip").c_str());
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(2.0 * M_PI * f / 3.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Vector3d expected = r * Eigen::Vector3d(d->geom_xpos + 3 * tip0);
+    EXPECT_LT((Eigen::Vector3d(d->geom_xpos + 3 * tip) - expected).norm(), 1e-12) << "finger " << f;
+  }
+  // Every wall segment rotated by 120 deg lands on another segment.
+  std::vector<Eigen::Vector3d> walls;
+  for (int g = 0; g < m->ngeom; ++g)
+    if (m->geom_type[g] == mjGEOM_BOX && m->geom_bodyid[g] == 0) walls.emplace_back(m->geom_pos + 3 * g);
+  ASSERT_EQ(walls.size() % 3, 0u);
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(2.0 * M_PI / 3.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (const auto& w : walls) {
+    double best = 1.0;
+    for (const auto& v : walls) best = std::min(best, (r * w - v).norm());
+    EXPECT_LT(best, 1e-12);
+  }
+}
+
+TEST(TrifingerLift, CubeAtGoalSucceedsAndThreeCentimetresAwayDoesNot) {
+  const TaskFactory f = makeFactory();
+  auto t = f.create();
+  const std::vector<float> hold(9, 0.0f);
+  for (int seed = 0; seed < 5; ++seed) {
+    Rng rng(seed);
+    t->reset(rng);
+    EXPECT_TRUE(t->episode().has_success);
+    putCubeAtGoal(*t, Eigen::Vector3d::Zero());
+    t->step(hold.data());  // one 20 ms step: the cube drops at most ~2 mm
+    EXPECT_TRUE(t->episode().success) << "seed " << seed;
+    // The keypoint kernel peaks at 1/4 per corner: weight 40 gives at most 10.
+    const double kp = t->rewardTerms()[termIndex(*t, "keypoints")];
+    EXPECT_GT(kp, 9.5);
+    EXPECT_LE(kp, 10.0);
+
+    t->reset(rng);
+    putCubeAtGoal(*t, Eigen::Vector3d(0.03, 0.0, 0.0));
+    t->step(hold.data());
+    EXPECT_FALSE(t->episode().success) << "seed " << seed;
+    EXPECT_LT(t->rewardTerms()[termIndex(*t, "keypoints")], 9.0);
+  }
+}
+
+TEST(TrifingerLift, ReachTermRewardsTheDecreaseOfFingertipToCubeDistance) {
+  const TaskFactory f = makeFactory();
+  auto t = f.create();
+  Rng rng(3);
+  t->reset(rng);
+  // Lowering the middle joints (action -1 = joint lower limit 0) swings the tips inward, to the cube.
+  const std::vector<float> inward = {0, -1, 1, 0, -1, 1, 0, -1, 1};
+  const double before = tipDistanceSum(*t);
+  t->step(inward.data());
+  const double after = tipDistanceSum(*t);
+  EXPECT_LT(after, before);
+  const double reach = t->rewardTerms()[termIndex(*t, "reach")];
+  EXPECT_NEAR(reach, -15.0 * (after - before), 1e-12);
+  EXPECT_GT(reach, 0.0);
+}
+
+TEST(TrifingerLift, EpisodeTruncatesAt750StepsWithoutTerminationPenalty) {
+  const TaskFactory f = makeFactory();
+  auto t = f.create();
+  Rng rng(4);
+  t->reset(rng);
+  const std::vector<float> hold(9, 0.0f);
+  StepOutcome o;
+  for (int s = 0; s < 750; ++s) {
+    o = t->step(hold.data());
+    ASSERT_FALSE(o.terminated);
+    if (s < 749) {
+      ASSERT_FALSE(o.truncated) << "step " << s;
+    }
+  }
+  EXPECT_TRUE(o.truncated);
+  EXPECT_EQ(t->episode().length, 750);
+  EXPECT_EQ(t->rewardTerms()[termIndex(*t, "termination")], 0.0);
+  EXPECT_GT(o.reward, -1.0);
+}
+
+std::vector<float> trajectory(const TaskFactory& f, std::uint64_t seed) {
+  auto t = f.create();
+  Rng rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> out, obs(41), act(9);
+  t->reset(rng);
+  for (int s = 0; s < 100; ++s) {
+    t->observe(obs.data());
+    out.insert(out.end(), obs.begin(), obs.end());
+    for (float& a : act) a = u(rng);
+    out.push_back(static_cast<float>(t->step(act.data()).reward));
+  }
+  return out;
+}
+
+TEST(TrifingerLift, SameSeedIsBitIdenticalDifferentSeedDiffers) {
+  const TaskFactory f = makeFactory();
+  const std::vector<float> a = trajectory(f, 7), b = trajectory(f, 7), c = trajectory(f, 8);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+  EXPECT_NE(a, c);
+}
+
+// Observations are float: joint velocities reach ~25 rad/s, where one float ulp is ~2e-6, and two
+// states that agree to 1e-13 may round to neighbouring floats; the observed worst is ~1e-7. The
+// simulator states themselves agree to ~1e-13 after a step (exact rotations of an exactly rotated
+// scene, contacts included), so joints and reward are held to 1e-9.
+constexpr double kTolerance = 1e-5;
+
+TEST(TrifingerLift, PhysicsSymmetryCheckPassesAndObservationIsEquivariant) {
+  const TaskFactory f = makeFactory();
+  SymmetryVerifierOptions opt;
+  opt.num_states = 20;
+  opt.max_warmup_steps = 100;
+  opt.tolerance = kTolerance;
+  const SymmetryReport r = verifySymmetry(f, opt);
+  EXPECT_TRUE(r.passed()) << r.summary(8);
+  double obs_map = 0.0;
+  for (const auto& e : r.observation_map) obs_map = std::max(obs_map, e.error);
+  EXPECT_LT(obs_map, kTolerance) << r.summary(8);
+  EXPECT_LT(r.reward_error, 1e-9) << r.summary(8);
+  for (const auto& e : r.joints) EXPECT_LT(e.error, 1e-9) << e.name;
+}
+
+// The upper joint is not mirror-symmetric (its range is [-0.33, 1.0] and the finger hangs off to one
+// side), so claiming that fingers 1 and 2 measure it with the opposite sign must be refuted by the
+// simulation, naming an upper joint.
+TEST(TrifingerLift, FlippedUpperJointSignInTheSpecFailsTheCheckNamingIt) {
+  YAML::Node root = YAML::LoadFile(kSpec);
+  root["action"]["limb"][0]["limb_signs"] = YAML::Load("[1, -1, -1]");
+  const TaskFactory f = makeFactory(sym::SymmetrySpec::parse(root, "broken trifinger_lift"));
+  SymmetryVerifierOptions opt;
+  opt.num_states = 3;
+  opt.tolerance = kTolerance;
+  const SymmetryReport r = verifySymmetry(f, opt);
+  ASSERT_FALSE(r.passed());
+  const auto worst = *std::max_element(r.joints.begin(), r.joints.end(),
+                                       [](const NamedError& a, const NamedError& b) { return a.error < b.error; });
+  EXPECT_TRUE(worst.name == "finger0_upper" || worst.name == "finger2_upper") << r.summary(8);
+  EXPECT_GT(worst.error, 1e-3);
+}
+
+}  // namespace
+}  // namespace masa::task
