@@ -1,0 +1,155 @@
+#include "tasks/humanoid_dribbling/humanoid_dribbling.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "common/task/registry.hpp"
+
+namespace masa::task {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+}
+
+HumanoidDribbling::HumanoidDribbling(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
+                                     EnvParams& params)
+    : HumanoidTask("humanoid_dribbling", std::move(model), spec, params,
+                   {{"velocity", 2.0},
+                    {"alive", 0.2},
+                    {"dist", 0.2},
+                    {"heading", 1.0},
+                    {"action", -0.01},
+                    {"energy", -0.05},
+                    {"lateral", -0.5}},
+                   /*start_hip_x_default=*/0.0, /*extra_central_obs=*/6) {
+  const mjModel* m = model_->get();
+  const int ball = model_->id(mjOBJ_JOINT, "ball");
+  ball_qpos_ = m->jnt_qposadr[ball];
+  ball_dof_ = m->jnt_dofadr[ball];
+  ball_radius_ = m->geom_size[3 * model_->id(mjOBJ_GEOM, "ball")];
+  ball_distance_ = params.positive("ball_distance", 0.6);
+  fall_height_ = params.positive("fall_height", 0.4);
+  max_ball_distance_ = params.positive("max_ball_distance", 5.0);
+  segment_min_ = params.positive("segment_length_min", 4.0);
+  segment_max_ = params.positive("segment_length_max", 8.0);
+  turn_min_ = params.number("turn_min_deg", 30.0) * kDeg;
+  turn_max_ = params.number("turn_max_deg", 90.0) * kDeg;
+  const int segments = params.integer("route_segments", 32, 1);
+  MASA_CHECK(segment_min_ <= segment_max_, "env.segment_length_min must not exceed env.segment_length_max");
+  MASA_CHECK(0.0 <= turn_min_ && turn_min_ <= turn_max_ && turn_max_ <= M_PI,
+             "env.turn_min_deg and env.turn_max_deg must satisfy 0 <= min <= max <= 180");
+  route_.resize(segments);
+  length_.resize(segments);
+}
+
+void HumanoidDribbling::resetTask(Rng& rng) {
+  randomizePose(rng);
+  start_z_ = standOnGround();
+  double* b = data_->qpos + ball_qpos_;
+  b[0] = ball_distance_;
+  b[1] = 0.0;
+  b[2] = ball_radius_;
+  for (int k = 0; k < 6; ++k) data_->qvel[ball_dof_ + k] = 0.0;
+
+  // The first segment starts under the torso along +x; each later one turns left or right.
+  std::uniform_real_distribution<double> len(segment_min_, segment_max_), turn(turn_min_, turn_max_);
+  std::bernoulli_distribution left(0.5);
+  route_[0] = PlanarFrame{};
+  for (size_t k = 0; k < route_.size(); ++k) {
+    length_[k] = len(rng);
+    if (k + 1 == route_.size()) break;
+    const PlanarFrame& s = route_[k];
+    const double dturn = left(rng) ? turn(rng) : -turn(rng);
+    route_[k + 1] = PlanarFrame{s.x + length_[k] * std::cos(s.heading), s.y + length_[k] * std::sin(s.heading),
+                                s.heading + dturn};
+  }
+  length_.back() = std::numeric_limits<double>::infinity();
+  current_ = 0;
+}
+
+const double* HumanoidDribbling::ballPos() const { return data_->qpos + ball_qpos_; }
+const double* HumanoidDribbling::ballLinVel() const { return data_->qvel + ball_dof_; }
+
+double HumanoidDribbling::torsoBallDistance() const {
+  const double* t = torsoPos();
+  const double* b = ballPos();
+  return std::hypot(b[0] - t[0], b[1] - t[1]);
+}
+
+void HumanoidDribbling::writeObservation(float* out) const {
+  const PlanarFrame& f = route_[current_];
+  writeHumanoidCentral(f, out);
+  float* ball = out + kTorsoObs + 3 * spec().actCentralDim();
+  const double* t = torsoPos();
+  const double* b = ballPos();
+  const double* v = ballLinVel();
+  const double rel[2] = {b[0] - t[0], b[1] - t[1]};
+  double loc[2];
+  f.rotateIn(rel, loc);  // ball relative to the torso, in the segment frame
+  ball[0] = static_cast<float>(loc[0]);
+  ball[1] = static_cast<float>(loc[1]);
+  ball[2] = static_cast<float>(b[2]);
+  f.rotateIn(v, loc);
+  ball[3] = static_cast<float>(loc[0]);
+  ball[4] = static_cast<float>(loc[1]);
+  ball[5] = static_cast<float>(v[2]);
+  writeLimbs(out + spec().obsCentralDim());
+}
+
+void HumanoidDribbling::computeRewardTerms(double* t) const {
+  const PlanarFrame& f = route_[current_];
+  double v[2], r[9];
+  f.rotateIn(ballLinVel(), v);
+  torsoRotation(r);
+  t[0] = v[0];                                                          // velocity: ball along the segment
+  t[1] = 1.0;                                                           // alive
+  t[2] = std::exp(-torsoBallDistance());                                // dist
+  t[3] = std::cos(f.heading) * r[0] + std::sin(f.heading) * r[3];       // heading: torso x axis . segment
+  t[4] = actionSquaredNorm();                                           // action
+  t[5] = jointPower();                                                 // energy
+  t[6] = std::abs(v[1]);                                                // lateral: |ball lateral velocity|
+}
+
+bool HumanoidDribbling::isTerminated() const {
+  return torsoPos()[2] < start_z_ - fall_height_ || torsoBallDistance() > max_ball_distance_;
+}
+
+void HumanoidDribbling::afterStep() {
+  // Re-anchor at each turn the torso has passed (along-track distance beyond the segment's end).
+  const double* t = torsoPos();
+  while (current_ + 1 < numSegments()) {
+    const PlanarFrame& f = route_[current_];
+    const double along = std::cos(f.heading) * (t[0] - f.x) + std::sin(f.heading) * (t[1] - f.y);
+    if (along < length_[current_]) break;
+    ++current_;
+  }
+}
+
+void HumanoidDribbling::transformExtras(int i) {
+  if (i % 2 == 0) return;
+  // The mirror y -> -y maps the route onto its mirror image: turns flip, lengths and progress keep.
+  for (PlanarFrame& f : route_) {
+    f.y = -f.y;
+    f.heading = -f.heading;
+  }
+}
+
+void HumanoidDribbling::copyExtrasFrom(const Task& other) {
+  const auto& o = static_cast<const HumanoidDribbling&>(other);
+  route_ = o.route_;
+  length_ = o.length_;
+  current_ = o.current_;
+  start_z_ = o.start_z_;
+}
+
+namespace {
+std::unique_ptr<Task> makeHumanoidDribbling(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
+                                            EnvParams& params) {
+  return std::make_unique<HumanoidDribbling>(std::move(model), spec, params);
+}
+}  // namespace
+
+MASA_REGISTER_TASK("humanoid_dribbling", "tasks/humanoid_dribbling/model.xml", &makeHumanoidDribbling);
+
+}  // namespace masa::task

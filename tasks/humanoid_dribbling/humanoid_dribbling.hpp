@@ -1,0 +1,47 @@
+// Humanoid Dribbling (paper appendix "Tasks Details"): dribble a ball along a route of straight
+// segments with random turns; observations are expressed in the current segment's frame, which is
+// re-anchored when the torso passes the segment's end. See README.md.
+#pragma once
+
+#include <vector>
+
+#include "tasks/humanoid_tightrope/humanoid_body.hpp"
+
+namespace masa::task {
+
+class HumanoidDribbling final : public HumanoidTask {
+ public:
+  HumanoidDribbling(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec, EnvParams& params);
+
+  // The route (world frame): segment k starts at segmentFrame(k) (x, y) with heading (rad) and
+  // runs segmentLength(k) metres; the last segment never ends.
+  int numSegments() const { return static_cast<int>(route_.size()); }
+  int currentSegment() const { return current_; }
+  const PlanarFrame& segmentFrame(int k) const { return route_[k]; }
+  double segmentLength(int k) const { return length_[k]; }
+
+ protected:
+  void resetTask(Rng& rng) override;
+  void writeObservation(float* out) const override;
+  void computeRewardTerms(double* t) const override;
+  bool isTerminated() const override;
+  void afterStep() override;
+  void transformExtras(int i) override;
+  void copyExtrasFrom(const Task& other) override;
+
+ private:
+  const double* ballPos() const;
+  const double* ballLinVel() const;
+  double torsoBallDistance() const;  // 2-D, m
+
+  int ball_qpos_, ball_dof_;
+  double ball_radius_;
+  double ball_distance_, fall_height_, max_ball_distance_;
+  double segment_min_, segment_max_, turn_min_, turn_max_;
+  std::vector<PlanarFrame> route_;
+  std::vector<double> length_;
+  int current_ = 0;
+  double start_z_ = 0.0;
+};
+
+}  // namespace masa::task

@@ -1,0 +1,433 @@
+// Humanoid Dribbling (tasks/humanoid_dribbling): loading, the random route and the re-anchoring of
+// the observation frame at each turn, reward terms and termination on hand-made states,
+// determinism, and the C2 symmetry (random states through the verifier; a ball pressed against a
+// foot and a state past a turn, where the route itself must be mirrored, through an inline check).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "common/config/run_config.hpp"
+#include "common/task/symmetry_verifier.hpp"
+#include "tasks/humanoid_dribbling/humanoid_dribbling.hpp"
+
+namespace masa::task {
+namespace {
+
+const std::string kRoot = MASA_SOURCE_DIR;
+const std::string kSpecPath = kRoot + "/configs/specs/humanoid_dribbling.yaml";
+
+YAML::Node shippedEnv() { return YAML::Clone(YAML::LoadFile(kRoot + "/configs/tasks/humanoid_dribbling.yaml")["env"]); }
+
+TaskFactory makeFactory(const YAML::Node& env = shippedEnv(),
+                        const sym::SymmetrySpec& spec = sym::SymmetrySpec::load(kSpecPath)) {
+  return TaskFactory("humanoid_dribbling", spec, env);
+}
+
+TaskFactory quietFactory() {
+  YAML::Node env = shippedEnv();
+  env["reset_noise"] = 0.0;
+  return makeFactory(env);
+}
+
+HumanoidDribbling& dribbling(std::unique_ptr<Task>& t) { return dynamic_cast<HumanoidDribbling&>(*t); }
+
+double term(const Task& t, const std::string& name) {
+  const auto& n = t.rewardTermNames();
+  const auto it = std::find(n.begin(), n.end(), name);
+  EXPECT_NE(it, n.end()) << name;
+  return t.rewardTerms()[it - n.begin()];
+}
+
+int obsIndex(const Task& t, const std::string& name) {
+  const auto& names = t.spec().obsNames();
+  const auto it = std::find(names.begin(), names.end(), name);
+  EXPECT_NE(it, names.end()) << name;
+  return static_cast<int>(it - names.begin());
+}
+
+std::vector<float> observe(const Task& t) {
+  std::vector<float> o(t.obsDim());
+  t.observe(o.data());
+  return o;
+}
+
+StepOutcome stepZero(Task& t) {
+  const std::vector<float> zero(t.actDim(), 0.0f);
+  return t.step(zero.data());
+}
+
+double* ballQpos(Task& t) { return t.data()->qpos + t.model()->jnt_qposadr[mj_name2id(t.model(), mjOBJ_JOINT, "ball")]; }
+double* ballQvel(Task& t) { return t.data()->qvel + t.model()->jnt_dofadr[mj_name2id(t.model(), mjOBJ_JOINT, "ball")]; }
+
+double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+TEST(HumanoidDribblingTask, LoadsFromRunConfigAndRuns1000RandomStepsWithFiniteValues) {
+  const config::RunConfig rc = config::loadRunConfig(kRoot + "/configs", {"task=humanoid_dribbling"});
+  TaskFactory f("humanoid_dribbling", sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin);
+  auto t = f.create();
+  ASSERT_EQ(t->obsDim(), 80);
+  ASSERT_EQ(t->actDim(), 21);
+  EXPECT_EQ(t->maxEpisodeSteps(), 1000);
+  Rng rng(1);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> obs(t->obsDim()), act(t->actDim());
+  t->reset(rng);
+  int episodes = 0;
+  for (int s = 0; s < 1000; ++s) {
+    for (float& a : act) a = u(rng);
+    const StepOutcome o = t->step(act.data());
+    t->observe(obs.data());
+    ASSERT_TRUE(std::isfinite(o.reward)) << "step " << s;
+    ASSERT_EQ(t->data()->warning[mjWARN_CONTACTFULL].number, 0) << "nconmax too small";
+    ASSERT_EQ(t->data()->warning[mjWARN_CNSTRFULL].number, 0) << "njmax too small";
+    for (int d = 0; d < t->obsDim(); ++d) ASSERT_TRUE(std::isfinite(obs[d])) << t->spec().obsNames()[d];
+    if (o.terminated || o.truncated) {
+      ++episodes;
+      t->reset(rng);
+    }
+  }
+  EXPECT_GT(episodes, 3);
+}
+
+TEST(HumanoidDribblingTask, ResetPlacesBallAheadAndDrawsARouteOfRandomTurns) {
+  TaskFactory f = makeFactory();
+  auto t = f.create();
+  HumanoidDribbling& d = dribbling(t);
+  int left = 0, right = 0;
+  for (int seed = 0; seed < 10; ++seed) {
+    Rng rng(seed);
+    t->reset(rng);
+    EXPECT_EQ(d.currentSegment(), 0);
+    EXPECT_EQ(d.segmentFrame(0).x, 0.0);
+    EXPECT_EQ(d.segmentFrame(0).heading, 0.0);
+    EXPECT_TRUE(std::isinf(d.segmentLength(d.numSegments() - 1)));
+    for (int k = 0; k + 1 < d.numSegments(); ++k) {
+      const PlanarFrame &a = d.segmentFrame(k), &b = d.segmentFrame(k + 1);
+      const double len = d.segmentLength(k), turn = b.heading - a.heading;
+      EXPECT_GE(len, 4.0);
+      EXPECT_LE(len, 8.0);
+      EXPECT_GE(std::abs(turn), 30.0 * M_PI / 180 - 1e-12);
+      EXPECT_LE(std::abs(turn), 90.0 * M_PI / 180 + 1e-12);
+      EXPECT_NEAR(b.x, a.x + len * std::cos(a.heading), 1e-9);
+      EXPECT_NEAR(b.y, a.y + len * std::sin(a.heading), 1e-9);
+      (turn > 0 ? left : right)++;
+    }
+    const std::vector<float> o = observe(*t);
+    EXPECT_NEAR(o[obsIndex(*t, "central.ball_pos[0]")], 0.6, 1e-6);  // ahead of the torso
+    EXPECT_NEAR(o[obsIndex(*t, "central.ball_pos[1]")], 0.0, 1e-6);
+    EXPECT_NEAR(o[obsIndex(*t, "central.ball_pos[2]")], 0.11, 1e-6);  // resting on the ground
+    // Feet on the ground: some foot contact, none penetrating.
+    for (int c = 0; c < t->data()->ncon; ++c) EXPECT_GT(t->data()->contact[c].dist, -1e-6);
+  }
+  EXPECT_GT(left, 50);
+  EXPECT_GT(right, 50);
+}
+
+// Teleporting the torso past the first turn re-anchors the frame: lateral offset, yaw and the ball
+// are then measured in segment 1's frame.
+TEST(HumanoidDribblingTask, CrossingATurnReanchorsTheObservationFrame) {
+  TaskFactory f = quietFactory();
+  auto t = f.create();
+  HumanoidDribbling& d = dribbling(t);
+  Rng rng(3);
+  t->reset(rng);
+  const PlanarFrame s1 = d.segmentFrame(1);
+  const double l0 = d.segmentLength(0);
+  const double c = std::cos(s1.heading), s = std::sin(s1.heading);
+  auto place = [&](double along, double lateral) {  // torso along segment 1 (negative: before the turn)
+    double* q = t->data()->qpos;
+    q[0] = s1.x + along * c - lateral * s;
+    q[1] = s1.y + along * s + lateral * c;
+    double* b = ballQpos(*t);
+    b[0] = s1.x + 0.6 * c;
+    b[1] = s1.y + 0.6 * s;
+    mj_forward(t->model(), t->data());
+  };
+  // Just before the turn on segment 0 (which runs along +x from the origin): not re-anchored.
+  t->data()->qpos[0] = l0 - 0.05;
+  mj_forward(t->model(), t->data());
+  stepZero(*t);
+  EXPECT_EQ(d.currentSegment(), 0);
+  std::vector<float> o = observe(*t);
+  EXPECT_NEAR(o[obsIndex(*t, "central.torso_yaw")], 0.0, 0.01);
+
+  // Past the turn, 0.2 m to the outside of the bend (so also past segment 0's end line).
+  const double lateral = s1.heading > 0 ? -0.2 : 0.2;
+  place(0.05, lateral);
+  o = observe(*t);  // still segment 0's frame until a step notices the crossing
+  EXPECT_NEAR(o[obsIndex(*t, "central.torso_y")], s1.y + 0.05 * s + lateral * c, 1e-5);
+  stepZero(*t);
+  ASSERT_EQ(d.currentSegment(), 1);
+  o = observe(*t);
+  EXPECT_NEAR(o[obsIndex(*t, "central.torso_y")], lateral, 0.01);
+  EXPECT_NEAR(o[obsIndex(*t, "central.torso_yaw")], wrapAngle(-s1.heading), 0.01);  // torso still faces +x
+  EXPECT_NEAR(o[obsIndex(*t, "central.ball_pos[0]")], 0.55, 0.01);
+  EXPECT_NEAR(o[obsIndex(*t, "central.ball_pos[1]")], -lateral, 0.01);
+  EXPECT_NEAR(term(*t, "heading"), std::cos(s1.heading), 0.01);  // weight 1.0
+}
+
+TEST(HumanoidDribblingTask, BallRollingAlongTheSegmentEarnsVelocityAndLateralTermsOnItsSpeed) {
+  TaskFactory f = quietFactory();
+  auto t = f.create();
+  Rng rng(0);
+  for (double vy : {0.4, -0.4}) {
+    t->reset(rng);
+    double* v = ballQvel(*t);
+    v[0] = 1.0;
+    v[1] = vy;
+    v[3] = -vy / 0.11;  // rolling without slipping (ball frame = world frame at reset)
+    v[4] = 1.0 / 0.11;
+    const StepOutcome o = stepZero(*t);
+    ASSERT_FALSE(o.terminated);
+    EXPECT_NEAR(term(*t, "velocity"), 2.0 * 1.0, 0.06);  // rolling friction slows it a little
+    EXPECT_NEAR(term(*t, "lateral"), -0.5 * 0.4, 0.03);  // |v_y|: the same on both sides
+    EXPECT_EQ(term(*t, "alive"), 0.2);
+    EXPECT_NEAR(term(*t, "heading"), 1.0, 1e-3);
+    const double* b = ballQpos(*t);
+    const double* p = t->data()->qpos;
+    EXPECT_NEAR(term(*t, "dist"), 0.2 * std::exp(-std::hypot(b[0] - p[0], b[1] - p[1])), 1e-12);
+    EXPECT_NEAR(term(*t, "dist"), 0.2 * std::exp(-0.6), 0.01);
+  }
+  // A resting ball earns no velocity reward.
+  t->reset(rng);
+  stepZero(*t);
+  EXPECT_LT(std::abs(term(*t, "velocity")), 1e-3);
+  EXPECT_EQ(term(*t, "action"), 0.0);
+  EXPECT_EQ(term(*t, "energy"), 0.0);
+}
+
+TEST(HumanoidDribblingTask, BallTooFarTerminatesWithExactlyMinusOne) {
+  TaskFactory f = quietFactory();
+  auto t = f.create();
+  Rng rng(0);
+  t->reset(rng);
+  ballQpos(*t)[0] = 4.5;
+  mj_forward(t->model(), t->data());
+  EXPECT_FALSE(stepZero(*t).terminated);
+  ballQpos(*t)[0] = 5.5;
+  mj_forward(t->model(), t->data());
+  const StepOutcome o = stepZero(*t);
+  EXPECT_TRUE(o.terminated);
+  EXPECT_EQ(o.reward, -1.0);
+  EXPECT_EQ(term(*t, "termination"), -1.0);
+}
+
+TEST(HumanoidDribblingTask, FallingTerminatesWithExactlyMinusOne) {
+  TaskFactory f = quietFactory();
+  auto t = f.create();
+  Rng rng(0);
+  t->reset(rng);
+  const double start_z = t->data()->qpos[2];
+  StepOutcome o;
+  int s = 0;
+  for (; s < 300 && !o.terminated; ++s) o = stepZero(*t);  // no torques: it collapses
+  ASSERT_TRUE(o.terminated);
+  EXPECT_LT(t->data()->qpos[2], start_z - 0.4);
+  EXPECT_EQ(o.reward, -1.0);
+  EXPECT_EQ(term(*t, "alive"), 0.0);
+  EXPECT_EQ(t->episode().length, s);
+}
+
+TEST(HumanoidDribblingTask, TimeLimitTruncatesWithoutPenalty) {
+  YAML::Node env = shippedEnv();
+  env["max_episode_steps"] = 4;
+  TaskFactory f = makeFactory(env);
+  auto t = f.create();
+  Rng rng(0);
+  t->reset(rng);
+  StepOutcome o;
+  for (int s = 0; s < 4; ++s) {
+    o = stepZero(*t);
+    ASSERT_FALSE(o.terminated);
+    EXPECT_EQ(o.truncated, s == 3);
+  }
+  EXPECT_EQ(term(*t, "termination"), 0.0);
+  EXPECT_GT(o.reward, 0.0);
+}
+
+std::vector<float> trajectory(const TaskFactory& f, std::uint64_t seed) {
+  auto t = f.create();
+  Rng rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> out, obs(t->obsDim()), act(t->actDim());
+  t->reset(rng);
+  for (int s = 0; s < 150; ++s) {
+    for (float& a : act) a = u(rng);
+    const StepOutcome o = t->step(act.data());
+    t->observe(obs.data());
+    out.insert(out.end(), obs.begin(), obs.end());
+    out.push_back(static_cast<float>(o.reward));
+    const HumanoidDribbling& d = dynamic_cast<const HumanoidDribbling&>(*t);
+    out.push_back(static_cast<float>(d.segmentFrame(1).heading));
+    if (o.terminated || o.truncated) t->reset(rng);
+  }
+  return out;
+}
+
+TEST(HumanoidDribblingTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
+  TaskFactory f = makeFactory();
+  const std::vector<float> a = trajectory(f, 7), b = trajectory(f, 7), c = trajectory(f, 8);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(float)));
+  EXPECT_NE(a, c);
+}
+
+// Same tolerance reasoning as the tightrope: the Newton solver agrees with its mirror to ~1e-12,
+// observations are exact sign flips (and rotations by the segment heading, ~1e-7 relative in
+// float), while wrong signs give errors of order 1e-3 or more.
+constexpr double kTolerance = 1e-6;
+
+struct MirrorMismatch {
+  double obs_map = 0.0, obs = 0.0, joints = 0.0, reward = 0.0;
+};
+
+// step(T s, T a) against T step(s, a) from the hand-made state s, for `steps` random actions.
+MirrorMismatch mirrorMismatch(const TaskFactory& f, const Task& s, int steps, Rng& rng) {
+  const sym::SymmetrySpec& spec = s.spec();
+  auto c = f.create(), b = f.create();
+  c->copyStateFrom(s);
+  b->copyStateFrom(s);
+  b->applySymmetry(1);
+  MirrorMismatch m;
+  Eigen::VectorXf oc(spec.obsDim()), ob(spec.obsDim()), toc(spec.obsDim()), a(spec.actDim()), ta(spec.actDim());
+  auto compareObs = [&](double& worst) {
+    c->observe(oc.data());
+    b->observe(ob.data());
+    spec.obsTransform(1).apply<float>(oc, toc);
+    for (int d = 0; d < spec.obsDim(); ++d)
+      worst = std::max(worst, std::abs(double(ob(d)) - double(toc(d))) / (1.0 + std::abs(double(toc(d)))));
+  };
+  compareObs(m.obs_map);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int k = 0; k < steps; ++k) {
+    for (int d = 0; d < spec.actDim(); ++d) a(d) = u(rng);
+    spec.actTransform(1).apply<float>(a, ta);
+    const StepOutcome rc = c->step(a.data()), rb = b->step(ta.data());
+    m.reward = std::max(m.reward, std::abs(rc.reward - rb.reward));
+    compareObs(m.obs);
+  }
+  c->applySymmetry(1);
+  const mjModel* mm = c->model();
+  for (int j = 0; j < mm->njnt; ++j) {
+    const int qa = mm->jnt_qposadr[j];
+    if (mm->jnt_type[j] == mjJNT_FREE) {
+      double same = 0.0, flipped = 0.0;
+      for (int q = 3; q < 7; ++q) {
+        same = std::max(same, std::abs(c->data()->qpos[qa + q] - b->data()->qpos[qa + q]));
+        flipped = std::max(flipped, std::abs(c->data()->qpos[qa + q] + b->data()->qpos[qa + q]));
+      }
+      m.joints = std::max(m.joints, std::min(same, flipped));
+      for (int q = 0; q < 3; ++q) m.joints = std::max(m.joints, std::abs(c->data()->qpos[qa + q] - b->data()->qpos[qa + q]));
+    } else {
+      m.joints = std::max(m.joints, std::abs(c->data()->qpos[qa] - b->data()->qpos[qa]));
+    }
+  }
+  for (int v = 0; v < mm->nv; ++v) m.joints = std::max(m.joints, std::abs(c->data()->qvel[v] - b->data()->qvel[v]));
+  return m;
+}
+
+TEST(HumanoidDribblingTask, PhysicsSymmetryVerifierPasses) {
+  TaskFactory f = makeFactory();
+  SymmetryVerifierOptions opt;
+  opt.num_states = 20;
+  opt.steps = 3;
+  opt.tolerance = kTolerance;
+  const SymmetryReport r = verifySymmetry(f, opt);
+  EXPECT_TRUE(r.passed()) << r.summary();
+  for (const auto& e : r.observation_map) EXPECT_EQ(e.error, 0.0) << e.name;  // segment 0 = world frame
+  std::printf("%s", r.summary(3).c_str());
+}
+
+TEST(HumanoidDribblingTask, SymmetryHoldsWithTheBallPressedAgainstAFoot) {
+  TaskFactory f = makeFactory();
+  auto t = f.create();
+  Rng rng(5);
+  t->reset(rng);
+  const mjData* d = t->data();
+  const int foot = mj_name2id(t->model(), mjOBJ_GEOM, "right_foot_outer");
+  double* b = ballQpos(*t);
+  // On the ground beside the foot's outer capsule, 3 mm into it.
+  const double dz = 0.11 - d->geom_xpos[3 * foot + 2];
+  b[0] = d->geom_xpos[3 * foot];
+  b[1] = d->geom_xpos[3 * foot + 1] - std::sqrt(std::pow(0.027 + 0.11 - 0.003, 2) - dz * dz);
+  b[2] = 0.11;
+  ballQvel(*t)[1] = 0.5;
+  mj_forward(t->model(), t->data());
+  const int ball = mj_name2id(t->model(), mjOBJ_GEOM, "ball");
+  bool touching = false;
+  for (int c = 0; c < d->ncon; ++c)
+    touching |= (d->contact[c].geom1 == ball && d->contact[c].geom2 == foot) ||
+                (d->contact[c].geom1 == foot && d->contact[c].geom2 == ball);
+  ASSERT_TRUE(touching);
+  const MirrorMismatch m = mirrorMismatch(f, *t, 5, rng);
+  EXPECT_LT(m.obs_map, kTolerance);
+  EXPECT_LT(m.obs, kTolerance);
+  EXPECT_LT(m.joints, 1e-8);
+  EXPECT_LT(m.reward, 1e-8);
+}
+
+// Past a turn the segment frame is not the world frame: the mirror must carry the route along
+// (turns flip sign), or the observation and the rewards break.
+TEST(HumanoidDribblingTask, SymmetryHoldsPastATurnWithTheRouteMirrored) {
+  TaskFactory f = makeFactory();
+  auto t = f.create();
+  HumanoidDribbling& d = dribbling(t);
+  Rng rng(11);
+  t->reset(rng);
+  const PlanarFrame s1 = d.segmentFrame(1);
+  t->data()->qpos[0] = s1.x + 0.1 * std::cos(s1.heading);
+  t->data()->qpos[1] = s1.y + 0.1 * std::sin(s1.heading);
+  ballQpos(*t)[0] = s1.x + 0.7 * std::cos(s1.heading);
+  ballQpos(*t)[1] = s1.y + 0.7 * std::sin(s1.heading);
+  mj_forward(t->model(), t->data());
+  stepZero(*t);
+  ASSERT_EQ(d.currentSegment(), 1);
+
+  auto mirrored = f.create();
+  mirrored->copyStateFrom(*t);
+  mirrored->applySymmetry(1);
+  const HumanoidDribbling& md = dynamic_cast<const HumanoidDribbling&>(*mirrored);
+  for (int k = 0; k < d.numSegments(); ++k) {
+    EXPECT_EQ(md.segmentFrame(k).heading, -d.segmentFrame(k).heading);
+    EXPECT_EQ(md.segmentFrame(k).y, -d.segmentFrame(k).y);
+    EXPECT_EQ(md.segmentFrame(k).x, d.segmentFrame(k).x);
+  }
+  EXPECT_EQ(md.currentSegment(), 1);
+
+  const MirrorMismatch m = mirrorMismatch(f, *t, 5, rng);
+  EXPECT_LT(m.obs_map, kTolerance);
+  EXPECT_LT(m.obs, kTolerance);
+  EXPECT_LT(m.joints, 1e-8);
+  EXPECT_LT(m.reward, 1e-8);
+}
+
+TEST(HumanoidDribblingTask, BallPositionDeclaredAxialFailsTheObservationMapNamingIt) {
+  YAML::Node root = YAML::LoadFile(kSpecPath);
+  for (YAML::Node e : root["observation"]["central"])
+    if (e["name"].as<std::string>() == "ball_pos") e["kind"] = "axial3";
+  YAML::Emitter out;
+  out << root;
+  TaskFactory f = makeFactory(shippedEnv(), sym::SymmetrySpec::parseString(out.c_str(), "edited"));
+  SymmetryVerifierOptions opt;
+  opt.num_states = 5;
+  opt.tolerance = kTolerance;
+  const SymmetryReport r = verifySymmetry(f, opt);
+  EXPECT_FALSE(r.passed());
+  for (const auto& e : r.observation_map) {
+    if (e.name == "central.ball_pos[0]" || e.name == "central.ball_pos[2]") {
+      EXPECT_GT(e.error, 0.05) << e.name;  // x ~ 0.6 and z = 0.11 flip sign where they must not
+    } else if (e.name != "central.ball_pos[1]") {
+      EXPECT_EQ(e.error, 0.0) << e.name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace masa::task
