@@ -71,10 +71,10 @@ void GemmWorkspace<S>::reserve(const std::vector<GemmPlan>& plans) {
 template <typename S>
 void GemmWorkspace<S>::run(const GemmPlan& plan, bool trans_a, bool trans_b, Index m, Index n, Index k, const S* a,
                            Index lda, const S* b, Index ldb, S* c, Index ldc, bool accumulate) {
-  MASA_CHECK(!threads_.empty(), "GemmWorkspace::run before reserve()");
   using StridedMap = Eigen::Map<Mat<S>, 0, Eigen::OuterStride<>>;
   if (!accumulate) StridedMap(c, m, n, Eigen::OuterStride<>(ldc)).setZero();
   if (m == 0 || n == 0 || k == 0) return;
+  MASA_CHECK(!threads_.empty(), "GemmWorkspace::run before reserve()");
 
   if (n == 1 && !trans_b) {
     // One column: Eigen's GEMV needs no packing and no buffer.

@@ -30,6 +30,9 @@ Mlp<S>::Mlp(ParameterSet<S>& params, const std::string& name, const MlpShape& sh
   }
   z_.resize(layers_.size());
   y_.resize(layers_.size());
+  // Buffers and plans for zero columns, so that even an empty first batch finds them consistent.
+  capacity_ = -1;
+  reserve(0);
 }
 
 template <typename S>
@@ -140,6 +143,7 @@ void Mlp<S>::backward(const ConstMatRef<S>& dy, MatRef<S>* dx) {
   Mat<S>* cur = &grad_a_;
   Mat<S>* next = &grad_b_;
   const int L = numLayers();
+  if (B == 0) return;
   {
     const Layer& l = layers_[L - 1];
     activateBackward<S>(l.act, z_[L - 1].leftCols(B), y_[L - 1].leftCols(B), dy, cur->topLeftCorner(l.out, B));

@@ -57,10 +57,10 @@ class Mlp {
   ParameterSet<S>* params_;
   MlpShape shape_;
   std::vector<Layer> layers_;
-  // Per layer: pre-activation z and post-activation y, capacity columns; plus one scratch for dy.
+  // Per layer: pre-activation z and post-activation y, capacity columns.
   std::vector<Mat<S>> z_, y_;
   Mat<S> input_;  // copy of the last forward's input (needed for the first layer's weight grad)
-  Mat<S> grad_a_, grad_b_;
+  Mat<S> grad_a_, grad_b_;  // backward's dz, alternating between layers (widest layer x capacity)
   // Products run on owned packing buffers (see gemm.hpp); per layer: forward, weight grad, input grad.
   GemmWorkspace<S> gemm_;
   std::vector<GemmPlan> plans_;

@@ -152,6 +152,14 @@ TEST(MlpForward, GrowsBuffersForLargerBatchesAndChecksInputRows) {
   EXPECT_THROW(net.mlp->backward(Mat<double>::Zero(2, 3)), std::invalid_argument);
 }
 
+TEST(MlpForward, EmptyBatchGivesEmptyOutputAndNoGradient) {
+  Net<float> net(shapeWith(3, {4}, 2, Activation::kElu), 6);
+  const Mat<float> x(3, 0);
+  EXPECT_EQ(net.mlp->forward(x).cols(), 0);
+  net.mlp->backward(Mat<float>(2, 0));
+  EXPECT_EQ(net.params.grads().squaredNorm(), 0.f);
+}
+
 TEST(MlpInitialize, FollowsPyTorchLinearBoundsScalesLastLayerAndIsReproducible) {
   const MlpShape shape = shapeWith(16, {64}, 4, Activation::kElu);
   ParameterSet<double> p1, p2;
