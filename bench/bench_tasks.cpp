@@ -1,7 +1,12 @@
-// Env steps per second per core for every task under random actions, next to raw mj_step
-// throughput of the same model with the same frame skip, so that the cost of observation, reward
-// and bookkeeping is visible. Run on one core:
-//   taskset -c 0 build/bench/bench_tasks --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// Env steps per second per core for every task under random actions, next to the bare physics
+// of the same steps, so that the cost of observation, reward and bookkeeping is visible.
+//
+// Both benchmarks replay one recorded sequence: random actions and the steps where episodes
+// ended, from one seed. TaskStep runs Task::step + observe; PhysicsOnly runs Task::advancePhysics
+// (clamp, actuation, frame-skip mj_step substeps with the task's PD loop) on the same actions
+// with resets at the same steps, i.e. the same trajectory without the task's own work.
+//   taskset -c 1 build/bench/bench_tasks --benchmark_repetitions=5
+//       --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
 #include "common/config/run_config.hpp"
@@ -11,60 +16,59 @@ namespace {
 
 using namespace masa;
 
-struct Prepared {
+constexpr std::uint64_t kSeed = 0;
+constexpr int kSteps = 2048;
+
+struct Replay {
   std::unique_ptr<task::TaskFactory> factory;
+  std::vector<float> actions;  // kSteps x act_dim
+  std::vector<char> done;      // episode ended at this step: reset before the next
 };
 
-Prepared prepare(const std::string& name) {
+Replay record(const std::string& name) {
   const auto rc = config::loadRunConfig(config::defaultConfigsDir(), {"task=" + name});
-  return {std::make_unique<task::TaskFactory>(rc.task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin)};
-}
-
-// Random actions are drawn up front: the benchmark measures the task, not the generator.
-std::vector<float> randomActions(int dim, int count, Rng& rng) {
+  Replay r{std::make_unique<task::TaskFactory>(rc.task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin), {}, {}};
+  auto env = r.factory->create();
+  Rng act_rng(kSeed + 1), reset_rng(kSeed);
   std::uniform_real_distribution<float> u(-1, 1);
-  std::vector<float> a(static_cast<size_t>(dim) * count);
-  for (float& v : a) v = u(rng);
-  return a;
+  r.actions.resize(static_cast<size_t>(kSteps) * env->actDim());
+  for (float& a : r.actions) a = u(act_rng);
+  r.done.resize(kSteps);
+  env->reset(reset_rng);
+  for (int k = 0; k < kSteps; ++k) {
+    const auto o = env->step(r.actions.data() + static_cast<size_t>(k) * env->actDim());
+    r.done[k] = o.terminated || o.truncated;
+    if (r.done[k]) env->reset(reset_rng);
+  }
+  return r;
 }
 
-void taskStep(benchmark::State& state, const std::string& name) {
-  auto p = prepare(name);
-  auto env = p.factory->create();
-  Rng rng(0);
-  const int n = 4096;
-  const auto actions = randomActions(env->actDim(), n, rng);
+template <bool kFullStep>
+void replay(benchmark::State& state, const std::string& name) {
+  const Replay r = record(name);
+  auto env = r.factory->create();
   std::vector<float> obs(env->obsDim());
-  env->reset(rng);
-  long k = 0;
+  Rng reset_rng(kSeed);
+  env->reset(reset_rng);
+  int k = 0;
   for (auto _ : state) {
-    const auto o = env->step(actions.data() + (k++ % n) * env->actDim());
-    env->observe(obs.data());
-    benchmark::DoNotOptimize(obs.data());
-    if (o.terminated || o.truncated) env->reset(rng);
+    const float* a = r.actions.data() + static_cast<size_t>(k) * env->actDim();
+    if constexpr (kFullStep) {
+      env->step(a);
+      env->observe(obs.data());
+      benchmark::DoNotOptimize(obs.data());
+    } else {
+      env->advancePhysics(a);
+    }
+    if (r.done[k]) env->reset(reset_rng);
+    if (++k == kSteps) {  // start the recorded sequence over, from the same seed
+      k = 0;
+      reset_rng.seed(kSeed);
+      env->reset(reset_rng);
+    }
   }
   state.SetItemsProcessed(state.iterations());
-  state.counters["frame_skip"] = env->controlTimestep() / env->model()->opt.timestep;
-}
-
-void rawMjStep(benchmark::State& state, const std::string& name) {
-  auto p = prepare(name);
-  auto env = p.factory->create();
-  Rng rng(0);
-  const int n = 4096, skip = static_cast<int>(std::lround(env->controlTimestep() / env->model()->opt.timestep));
-  const mjModel* m = env->model();
-  mjData* d = env->data();
-  const auto ctrls = randomActions(m->nu, n, rng);
-  env->reset(rng);
-  long k = 0;
-  for (auto _ : state) {
-    const float* c = ctrls.data() + (k % n) * m->nu;
-    for (int a = 0; a < m->nu; ++a) d->ctrl[a] = c[a];
-    for (int s = 0; s < skip; ++s) mj_step(m, d);
-    // Same reset cadence as a failing random policy would see, without the task's checks.
-    if (++k % 64 == 0) env->reset(rng);
-  }
-  state.SetItemsProcessed(state.iterations());
+  state.counters["frame_skip"] = std::round(env->controlTimestep() / env->model()->opt.timestep);
 }
 
 }  // namespace
@@ -73,8 +77,8 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   for (const std::string& name : masa::task::registeredTasks()) {
     if (name == "mjcf") continue;
-    benchmark::RegisterBenchmark(("RawMjStep/" + name).c_str(), rawMjStep, name);
-    benchmark::RegisterBenchmark(("TaskStep/" + name).c_str(), taskStep, name);
+    benchmark::RegisterBenchmark(("PhysicsOnly/" + name).c_str(), replay<false>, name);
+    benchmark::RegisterBenchmark(("TaskStep/" + name).c_str(), replay<true>, name);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

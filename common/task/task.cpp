@@ -86,20 +86,25 @@ StepOutcome Task::step(std::span<const float> action) {
   return step(action.data());
 }
 
-StepOutcome Task::step(const float* action) {
+void Task::advancePhysics(const float* action) {
   const mjModel* m = model_->get();
   for (int k = 0; k < actDim(); ++k) {
     const double a = static_cast<double>(action[k]);
     // NaN actions become 0: a policy bug must not poison the simulator state.
     action_scratch_[k] = std::isfinite(a) ? std::clamp(a, -1.0, 1.0) : 0.0;
   }
-  last_action_ = action_scratch_;
+  std::copy(action_scratch_.begin(), action_scratch_.end(), last_action_.begin());
   applyAction(action_scratch_.data());
-  const int bad_before = data_->warning[mjWARN_BADQACC].number;
   for (int s = 0; s < frame_skip_; ++s) {
     beforeSubstep();
     mj_step(m, data_);
   }
+}
+
+StepOutcome Task::step(const float* action) {
+  const mjModel* m = model_->get();
+  const int bad_before = data_->warning[mjWARN_BADQACC].number;
+  advancePhysics(action);
   // mj_step leaves body poses at the start of its last substep: observations, rewards and
   // terminations must see the state the step ended in (the symmetry verifier compares exactly that).
   mj_kinematics(m, data_);

@@ -60,6 +60,10 @@ class Task {
   void observe(float* out) const;             // obsDim() values
   StepOutcome step(const float* action);      // actDim() values, clamped to [-1, 1]
   StepOutcome step(std::span<const float> action);  // the same, checking the size
+  // The physics of step() alone: clamping, actuation, frame-skip substeps (with their control
+  // hooks). No pose refresh, reward, termination or statistics: for benchmarks that separate the
+  // simulator's cost from the task's, replaying the same actions along the same trajectory.
+  void advancePhysics(const float* action);
   const EpisodeStats& episode() const { return episode_; }
 
   // Whole-state symmetry: the state becomes T_i of itself (then mj_forward). The verifier compares
