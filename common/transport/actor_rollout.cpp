@@ -1,0 +1,66 @@
+#include "common/transport/actor_rollout.hpp"
+
+#include <algorithm>
+
+#include "common/core/check.hpp"
+
+namespace masa::transport {
+
+void ActorRollout::allocate(int e, int t, int od, int ad, const std::vector<std::string>& names) {
+  MASA_CHECK(e > 0 && t > 0 && od > 0 && ad > 0,
+             "rollout shape must be positive: E=" << e << " T=" << t << " obs=" << od << " act=" << ad);
+  if (e == num_envs && t == horizon && od == obs_dim && ad == act_dim && names == term_names) {
+    return;
+  }
+  num_envs = e;
+  horizon = t;
+  obs_dim = od;
+  act_dim = ad;
+  term_names = names;
+  const std::size_t steps = static_cast<std::size_t>(t) * e;
+  obs.assign((steps + e) * od, 0.0f);
+  actions.assign(steps * ad, 0.0f);
+  mean.assign(steps * ad, 0.0f);
+  log_prob.assign(steps, 0.0f);
+  reward.assign(steps, 0.0f);
+  terminated.assign(steps, 0);
+  truncated.assign(steps, 0);
+  log_std.assign(ad, 0.0f);
+  clearEvents();
+  final_index.reserve(steps);
+  final_obs.reserve(steps * od);
+  episode_env.reserve(steps);
+  episode_return.reserve(steps);
+  episode_length.reserve(steps);
+  episode_success.reserve(steps);
+  episode_term_sums.reserve(steps * names.size());
+}
+
+void ActorRollout::clearEvents() {
+  final_index.clear();
+  final_obs.clear();
+  episode_env.clear();
+  episode_return.clear();
+  episode_length.clear();
+  episode_success.clear();
+  episode_term_sums.clear();
+}
+
+void ActorRollout::addFinal(int t, int e, const float* pre_reset_obs) {
+  MASA_CHECK(t >= 0 && t < horizon && e >= 0 && e < num_envs, "final step (" << t << ", " << e << ") out of range");
+  const int idx = static_cast<int>(step(t, e));
+  MASA_CHECK(final_index.empty() || final_index.back() < idx, "finals must be added in ascending step order");
+  final_index.push_back(idx);
+  final_obs.insert(final_obs.end(), pre_reset_obs, pre_reset_obs + obs_dim);
+}
+
+void ActorRollout::addEpisode(int e, float ret, int length, int8_t success, const float* term_sums) {
+  MASA_CHECK(e >= 0 && e < num_envs, "episode env " << e << " out of range");
+  episode_env.push_back(e);
+  episode_return.push_back(ret);
+  episode_length.push_back(length);
+  episode_success.push_back(success);
+  if (numTerms() > 0) episode_term_sums.insert(episode_term_sums.end(), term_sums, term_sums + numTerms());
+}
+
+}  // namespace masa::transport

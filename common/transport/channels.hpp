@@ -1,0 +1,12 @@
+// LCM channel names of masa. One set per network: messages of another run on the same channels
+// are told apart by run_id and dropped.
+#pragma once
+
+namespace masa::transport {
+
+inline constexpr const char* kRolloutChannel = "MASA_ROLLOUT";           // lcmt_rollout_chunk
+inline constexpr const char* kPolicyChannel = "MASA_POLICY";             // lcmt_policy_params
+inline constexpr const char* kLearnerStatsChannel = "MASA_LEARNER_STATS";  // lcmt_learner_stats
+inline constexpr const char* kHeartbeatChannel = "MASA_ACTOR_HEARTBEAT";   // lcmt_actor_heartbeat
+
+}  // namespace masa::transport

@@ -1,0 +1,28 @@
+#include "common/transport/drop_reason.hpp"
+
+namespace masa::transport {
+
+std::string_view dropReasonName(DropReason r) {
+  switch (r) {
+    case DropReason::kAccepted: return "accepted";
+    case DropReason::kMalformed: return "malformed";
+    case DropReason::kWrongRun: return "wrong_run";
+    case DropReason::kWrongDims: return "wrong_dims";
+    case DropReason::kBadLength: return "bad_length";
+    case DropReason::kNonFinite: return "non_finite";
+    case DropReason::kFutureVersion: return "future_version";
+    case DropReason::kTooOld: return "too_old";
+    case DropReason::kDuplicate: return "duplicate";
+    case DropReason::kOutOfRange: return "out_of_range";
+    case DropReason::kCount: break;
+  }
+  return "unknown";
+}
+
+int64_t DropStats::dropped() const {
+  int64_t n = 0;
+  for (int i = 1; i < kNumDropReasons; ++i) n += count[i];
+  return n;
+}
+
+}  // namespace masa::transport

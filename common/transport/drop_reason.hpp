@@ -1,0 +1,36 @@
+// Why the learner drops a rollout chunk, and the counters it keeps per reason (reported in
+// lcmt_learner_stats). Every drop is counted: loss is expected on UDP, silent loss is not.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+namespace masa::transport {
+
+enum class DropReason : int {
+  kAccepted = 0,   // not a drop
+  kMalformed,      // bytes that do not decode as lcmt_rollout_chunk (bad hash, truncated, lengths past the end)
+  kWrongRun,       // run_id of another training run
+  kWrongDims,      // horizon / obs_dim / act_dim differ from the learner's
+  kBadLength,      // an array length field disagrees with the dimensions, or an array with its length field
+  kNonFinite,      // NaN or Inf in a float
+  kFutureVersion,  // policy_version newer than the learner's current version
+  kTooOld,         // policy_version older than current - max_policy_lag
+  kDuplicate,      // the same (actor, rollout, chunk) already arrived, or its rollout is too far behind to tell
+  kOutOfRange,     // an index or enumerated value out of its range (chunk index, env range, final index, flags)
+  kCount
+};
+
+inline constexpr int kNumDropReasons = static_cast<int>(DropReason::kCount);
+
+// Stable snake_case names, as sent in lcmt_learner_stats.drop_reason_names.
+std::string_view dropReasonName(DropReason r);
+
+struct DropStats {
+  std::array<int64_t, kNumDropReasons> count{};  // count[kAccepted] = accepted chunks
+  int64_t operator[](DropReason r) const { return count[static_cast<int>(r)]; }
+  int64_t dropped() const;  // all reasons but kAccepted
+};
+
+}  // namespace masa::transport

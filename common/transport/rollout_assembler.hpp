@@ -1,0 +1,98 @@
+// The learner's gate for rollout chunks: every chunk is hostile until validated.
+//
+// A chunk is accepted only if it belongs to this run, has the learner's dimensions, consistent
+// array lengths, indices in range, finite floats, a policy version within the allowed lag, and
+// was not seen before. Everything else is dropped and counted under its reason (DropStats), with
+// a rate-limited warning on stderr. An accepted chunk is usable on its own: chunks hold whole
+// environments, so a rollout whose other chunks were lost still delivers the environments that
+// arrived, and nothing ever waits for a missing chunk.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "common/transport/drop_reason.hpp"
+#include "masa/lcmt_rollout_chunk.hpp"
+
+namespace masa::transport {
+
+struct AssemblerConfig {
+  int64_t run_id = 0;
+  int horizon = 0;  // the learner's T, obs_dim and act_dim; chunks must match exactly
+  int obs_dim = 0;
+  int act_dim = 0;
+  int max_policy_lag = 0;            // accept versions in [current - lag, current]
+  int max_actors = 4096;             // actor_id must be below
+  int max_envs_per_actor = 1 << 16;  // env_offset + num_envs must not exceed
+  int max_terms = 256;               // num_terms must not exceed
+  int dedup_window = 16;             // rollouts per actor remembered to detect duplicates
+  double warn_interval_s = 5.0;      // at most one warning per reason per interval; < 0: silent
+};
+
+// A chunk that passed validation. Only RolloutAssembler makes them, so code that takes one (the
+// BatchCollector) cannot be handed unchecked input. Refers to the message it was made from.
+class ValidatedChunk {
+ public:
+  const masa::lcmt_rollout_chunk& msg() const { return *msg_; }
+  int64_t version() const { return msg_->policy_version; }
+  int numEnvs() const { return msg_->num_envs; }
+
+ private:
+  friend class RolloutAssembler;
+  explicit ValidatedChunk(const masa::lcmt_rollout_chunk* m) : msg_(m) {}
+  const masa::lcmt_rollout_chunk* msg_;
+};
+
+struct Verdict {
+  DropReason reason = DropReason::kMalformed;
+  std::optional<ValidatedChunk> chunk;  // set exactly when reason == kAccepted
+  explicit operator bool() const { return chunk.has_value(); }
+};
+
+class RolloutAssembler {
+ public:
+  explicit RolloutAssembler(const AssemblerConfig& config);
+
+  // The learner's current parameter version; chunks newer than it, or older than
+  // version - max_policy_lag, are dropped from now on.
+  void setLearnerVersion(int64_t version) { version_ = version; }
+  int64_t learnerVersion() const { return version_; }
+
+  // Validates a decoded chunk; an accepted chunk refers to `msg`, which must outlive its use.
+  Verdict accept(const masa::lcmt_rollout_chunk& msg);
+  // Bounds-checks and decodes raw LCM bytes into an internal message (reused, so the returned
+  // chunk is valid until the next acceptEncoded), then validates it.
+  Verdict acceptEncoded(const void* data, int size);
+
+  const DropStats& stats() const { return stats_; }
+  const AssemblerConfig& config() const { return cfg_; }
+
+ private:
+  DropReason validate(const masa::lcmt_rollout_chunk& m) const;
+  DropReason markSeen(const masa::lcmt_rollout_chunk& m);
+  Verdict finish(DropReason reason, const masa::lcmt_rollout_chunk* m);
+
+  struct SeenRollout {
+    int64_t seq = -1;  // -1: slot unused
+    int32_t num_chunks = 0;
+    std::vector<uint64_t> bits;  // one bit per chunk index
+  };
+  struct ActorWindow {
+    std::vector<SeenRollout> rollouts;  // dedup_window slots, replaced oldest first
+  };
+
+  AssemblerConfig cfg_;
+  int64_t version_ = 0;
+  DropStats stats_;
+  std::vector<ActorWindow> actors_;  // indexed by actor_id, grown on first sight
+  masa::lcmt_rollout_chunk decoded_;  // reused by acceptEncoded
+
+  // Rate limiting of warnings, per reason.
+  std::chrono::steady_clock::time_point last_warn_[kNumDropReasons];
+  int64_t suppressed_[kNumDropReasons] = {};
+  bool warned_[kNumDropReasons] = {};
+};
+
+}  // namespace masa::transport

@@ -1,0 +1,182 @@
+#include "common/transport/rollout_chunker.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "common/core/check.hpp"
+
+namespace masa::transport {
+
+RolloutChunker::RolloutChunker(int byte_budget) : budget_(byte_budget) {
+  MASA_CHECK(byte_budget > 0, "chunk byte budget must be positive, got " << byte_budget);
+}
+
+int RolloutChunker::emptyChunkBytes(int act_dim, const std::vector<std::string>& term_names) {
+  // Hash, 11 header fields, the 9 length fields, log_std and the term names.
+  int bytes = 8 + (8 + 4 + 8 + 4 + 4 + 8 + 4 * 5) + 4 * 9 + 4 * act_dim;
+  for (const std::string& s : term_names) bytes += 4 + static_cast<int>(s.size()) + 1;
+  return bytes;
+}
+
+int RolloutChunker::envBytes(int horizon, int obs_dim, int act_dim) {
+  const int t = horizon;
+  return 4 * (t + 1) * obs_dim + 2 * 4 * t * act_dim + 2 * 4 * t + 2 * t;
+}
+
+int RolloutChunker::maxEnvsPerChunk(int byte_budget, int horizon, int obs_dim, int act_dim,
+                                    const std::vector<std::string>& term_names) {
+  const int room = byte_budget - emptyChunkBytes(act_dim, term_names);
+  return std::max(1, room / envBytes(horizon, obs_dim, act_dim));
+}
+
+void RolloutChunker::plan(const ActorRollout& r) {
+  const int E = r.num_envs;
+  env_finals_.assign(E, 0);
+  env_episodes_.assign(E, 0);
+  for (int32_t idx : r.final_index) ++env_finals_[idx % E];
+  for (int32_t e : r.episode_env) ++env_episodes_[e];
+
+  const int empty = emptyChunkBytes(r.act_dim, r.term_names);
+  const int per_env = envBytes(r.horizon, r.obs_dim, r.act_dim);
+  const int per_final = finalBytes(r.obs_dim), per_episode = episodeBytes(r.numTerms());
+  chunk_offset_.clear();
+  chunk_envs_.clear();
+  int offset = 0, n = 0, bytes = empty;
+  for (int e = 0; e < E; ++e) {
+    const int add = per_env + env_finals_[e] * per_final + env_episodes_[e] * per_episode;
+    if (n > 0 && bytes + add > budget_) {
+      chunk_offset_.push_back(offset);
+      chunk_envs_.push_back(n);
+      offset = e;
+      n = 0;
+      bytes = empty;
+    }
+    ++n;
+    bytes += add;
+  }
+  chunk_offset_.push_back(offset);
+  chunk_envs_.push_back(n);
+}
+
+std::span<const masa::lcmt_rollout_chunk> RolloutChunker::split(const ActorRollout& r, const RolloutIdentity& id) {
+  MASA_CHECK(r.num_envs > 0 && r.horizon > 0, "rollout not allocated");
+  MASA_CHECK(r.final_obs.size() == r.final_index.size() * r.obs_dim, "final_obs size does not match final_index");
+  MASA_CHECK(r.episode_term_sums.size() == r.episode_env.size() * r.term_names.size(),
+             "episode_term_sums size does not match episodes x terms");
+  plan(r);
+  const int num_chunks = static_cast<int>(chunk_envs_.size());
+  if (static_cast<int>(chunks_.size()) < num_chunks) {
+    // New messages are reserved for the largest chunk this shape allows, so later rollouts whose
+    // packing shifts still fit without reallocating.
+    const int cap = std::min(r.num_envs, maxEnvsPerChunk(budget_, r.horizon, r.obs_dim, r.act_dim, r.term_names));
+    const std::size_t steps = static_cast<std::size_t>(cap) * r.horizon;
+    while (static_cast<int>(chunks_.size()) < num_chunks) {
+      masa::lcmt_rollout_chunk& c = chunks_.emplace_back();
+      c.obs.reserve((steps + cap) * r.obs_dim);
+      c.actions.reserve(steps * r.act_dim);
+      c.mean.reserve(steps * r.act_dim);
+      c.log_prob.reserve(steps);
+      c.reward.reserve(steps);
+      c.terminated.reserve(steps);
+      c.truncated.reserve(steps);
+      c.final_index.reserve(steps);
+      c.final_obs.reserve(steps * r.obs_dim);
+      c.episode_env.reserve(steps);
+      c.episode_return.reserve(steps);
+      c.episode_length.reserve(steps);
+      c.episode_success.reserve(steps);
+      c.episode_term_sums.reserve(steps * r.term_names.size());
+    }
+  }
+  const int empty = emptyChunkBytes(r.act_dim, r.term_names);
+  for (int i = 0; i < num_chunks; ++i) {
+    masa::lcmt_rollout_chunk& c = chunks_[i];
+    fill(c, r, id, i, num_chunks, chunk_offset_[i], chunk_envs_[i]);
+    const int expected = empty + chunk_envs_[i] * envBytes(r.horizon, r.obs_dim, r.act_dim) +
+                         c.num_final * finalBytes(r.obs_dim) + c.num_episodes * episodeBytes(r.numTerms());
+    // Keeps the size arithmetic above honest if the .lcm layout changes.
+    MASA_CHECK(c.getEncodedSize() == expected,
+               "chunk size formula out of date: " << c.getEncodedSize() << " != " << expected);
+    if (expected > budget_) ++oversize_;
+  }
+  return {chunks_.data(), static_cast<std::size_t>(num_chunks)};
+}
+
+namespace {
+// Copies rows t = 0..rows-1 of n consecutive envs starting at `offset` (dim values each) from an
+// E-env step-major array into an n-env step-major array.
+template <typename T>
+void copyRows(std::vector<T>& dst, const std::vector<T>& src, int rows, int E, int offset, int n, int dim) {
+  const std::size_t row = static_cast<std::size_t>(n) * dim;
+  dst.resize(rows * row);
+  for (int t = 0; t < rows; ++t) {
+    std::memcpy(dst.data() + t * row, src.data() + (static_cast<std::size_t>(t) * E + offset) * dim, row * sizeof(T));
+  }
+}
+}  // namespace
+
+void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const ActorRollout& r, const RolloutIdentity& id, int index,
+                          int num_chunks, int offset, int n) const {
+  const int E = r.num_envs, T = r.horizon;
+  c.run_id = id.run_id;
+  c.actor_id = id.actor_id;
+  c.rollout_seq = id.rollout_seq;
+  c.chunk_index = index;
+  c.num_chunks = num_chunks;
+  c.policy_version = id.policy_version;
+  c.horizon = T;
+  c.obs_dim = r.obs_dim;
+  c.act_dim = r.act_dim;
+  c.num_envs = n;
+  c.env_offset = offset;
+
+  copyRows(c.obs, r.obs, T + 1, E, offset, n, r.obs_dim);
+  copyRows(c.actions, r.actions, T, E, offset, n, r.act_dim);
+  copyRows(c.mean, r.mean, T, E, offset, n, r.act_dim);
+  copyRows(c.log_prob, r.log_prob, T, E, offset, n, 1);
+  copyRows(c.reward, r.reward, T, E, offset, n, 1);
+  copyRows(c.terminated, r.terminated, T, E, offset, n, 1);
+  copyRows(c.truncated, r.truncated, T, E, offset, n, 1);
+  c.obs_len = static_cast<int32_t>(c.obs.size());
+  c.act_len = static_cast<int32_t>(c.actions.size());
+  c.step_len = static_cast<int32_t>(c.log_prob.size());
+  c.log_std.assign(r.log_std.begin(), r.log_std.end());
+  c.log_std_len = static_cast<int32_t>(c.log_std.size());
+
+  // Truncations stay in ascending order: the global order is (t, e) and the chunk's envs are a
+  // contiguous range, so filtering keeps (t, local e) ascending.
+  c.final_index.clear();
+  c.final_obs.clear();
+  for (int i = 0; i < r.numFinal(); ++i) {
+    const int t = r.final_index[i] / E, e = r.final_index[i] % E;
+    if (e < offset || e >= offset + n) continue;
+    c.final_index.push_back(t * n + (e - offset));
+    const float* o = r.final_obs.data() + static_cast<std::size_t>(i) * r.obs_dim;
+    c.final_obs.insert(c.final_obs.end(), o, o + r.obs_dim);
+  }
+  c.num_final = static_cast<int32_t>(c.final_index.size());
+  c.final_obs_len = static_cast<int32_t>(c.final_obs.size());
+
+  const int K = r.numTerms();
+  c.episode_env.clear();
+  c.episode_return.clear();
+  c.episode_length.clear();
+  c.episode_success.clear();
+  c.episode_term_sums.clear();
+  for (int i = 0; i < r.numEpisodes(); ++i) {
+    const int e = r.episode_env[i];
+    if (e < offset || e >= offset + n) continue;
+    c.episode_env.push_back(e);
+    c.episode_return.push_back(r.episode_return[i]);
+    c.episode_length.push_back(r.episode_length[i]);
+    c.episode_success.push_back(r.episode_success[i]);
+    const float* s = r.episode_term_sums.data() + static_cast<std::size_t>(i) * K;
+    c.episode_term_sums.insert(c.episode_term_sums.end(), s, s + K);
+  }
+  c.num_episodes = static_cast<int32_t>(c.episode_env.size());
+  c.term_names = r.term_names;  // element-wise assignment: reuses the strings' storage
+  c.num_terms = static_cast<int32_t>(c.term_names.size());
+  c.term_sums_len = static_cast<int32_t>(c.episode_term_sums.size());
+}
+
+}  // namespace masa::transport

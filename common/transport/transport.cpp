@@ -1,0 +1,69 @@
+#include "common/transport/transport.hpp"
+
+#include <chrono>
+#include <iostream>
+#include <lcm/lcm-cpp.hpp>
+#include <stdexcept>
+
+namespace masa::transport {
+
+int64_t wallClockMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+Transport::Transport(const std::string& url) : url_(url) {
+  const int64_t requested = recvBufSizeOf(url);
+  if (requested > 0) {
+    recv_buf_ = checkRecvBuf(requested);
+    if (!recv_buf_.sufficient) std::cerr << "masa transport: warning: " << recv_buf_.message << "\n";
+  }
+  lcm_ = std::make_unique<lcm::LCM>(url);
+  if (!lcm_->good()) {
+    throw std::runtime_error("masa transport: LCM failed to start on '" + url +
+                             "' (for udpm: is multicast routed? e.g. ip route add 224.0.0.0/4 dev lo)");
+  }
+}
+
+Transport::~Transport() {
+  for (Sub& s : subs_) lcm_->unsubscribe(s.lcm_sub);
+}
+
+bool Transport::publishRaw(const std::string& channel, const void* data, int size) {
+  return lcm_->publish(channel, data, static_cast<unsigned int>(size)) == 0;
+}
+
+void Transport::dispatch(const void* rbuf, const std::string&, Sub* sub) {
+  const auto* rb = static_cast<const lcm::ReceiveBuffer*>(rbuf);
+  sub->handler(rb->data, static_cast<int>(rb->data_size));
+}
+
+Transport::SubscriptionId Transport::subscribeRaw(const std::string& channel, RawHandler handler) {
+  Sub& s = subs_.emplace_back();
+  s.id = next_id_++;
+  s.handler = std::move(handler);
+  s.lcm_sub = lcm_->subscribeFunction<Sub*>(
+      channel,
+      [](const lcm::ReceiveBuffer* rb, const std::string& ch, Sub* sub) { dispatch(rb, ch, sub); }, &s);
+  return s.id;
+}
+
+void Transport::unsubscribe(SubscriptionId id) {
+  for (auto it = subs_.begin(); it != subs_.end(); ++it) {
+    if (it->id == id) {
+      lcm_->unsubscribe(it->lcm_sub);
+      subs_.erase(it);
+      return;
+    }
+  }
+}
+
+int Transport::handleTimeout(int timeout_ms) { return lcm_->handleTimeout(timeout_ms); }
+
+int Transport::drain() {
+  int n = 0;
+  while (lcm_->handleTimeout(0) > 0) ++n;
+  return n;
+}
+
+}  // namespace masa::transport

@@ -1,0 +1,114 @@
+// The one door to LCM: a lcm::LCM on a provider URL (udpm:// multicast, memq:// in-process for
+// tests, tcpq:// through a hub where multicast is not routed, file:// to replay a log), with typed
+// publish/subscribe and a bounded wait. Nothing above this layer includes lcm-cpp.hpp, so the
+// transport could be replaced without touching actors or the learner.
+//
+// Threading: publish() may be called from any thread; handle*() and (un)subscribe() from one
+// thread (handlers run on the thread that calls handle*()).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "common/transport/lcm_url.hpp"
+
+namespace lcm {
+class LCM;
+class Subscription;
+}  // namespace lcm
+
+namespace masa::transport {
+
+// Microseconds since the Unix epoch (the utime fields of the messages).
+int64_t wallClockMicros();
+
+class Transport {
+ public:
+  using RawHandler = std::function<void(const void* data, int size)>;
+  using SubscriptionId = int;
+
+  // "" uses LCM_DEFAULT_URL (or LCM's own default). Throws std::runtime_error when LCM cannot
+  // start on the URL. For a udpm URL, warns on stderr when net.core.rmem_max is below the
+  // requested recv_buf_size (see recvBufCheck()).
+  explicit Transport(const std::string& url);
+  ~Transport();
+  Transport(const Transport&) = delete;
+  Transport& operator=(const Transport&) = delete;
+
+  const std::string& url() const { return url_; }
+  const RecvBufCheck& recvBufCheck() const { return recv_buf_; }
+
+  // Encodes into a reused buffer and publishes; returns false when LCM reports a failure.
+  template <class Msg>
+  bool publish(const std::string& channel, const Msg& msg);
+  bool publishRaw(const std::string& channel, const void* data, int size);
+
+  // Raw bytes, for input that must be bounds-checked before decoding (rollout chunks: see
+  // RolloutAssembler::acceptEncoded).
+  SubscriptionId subscribeRaw(const std::string& channel, RawHandler handler);
+  // Decoded messages. A message that fails to decode is counted (decodeErrors()) and skipped.
+  template <class Msg>
+  SubscriptionId subscribe(const std::string& channel, std::function<void(const Msg&)> handler);
+  void unsubscribe(SubscriptionId id);
+
+  // Dispatches at most one message, waiting up to timeout_ms: >0 handled, 0 timed out, <0 error.
+  int handleTimeout(int timeout_ms);
+  // Dispatches every message already queued (without waiting); returns how many.
+  int drain();
+
+  int64_t decodeErrors() const { return decode_errors_; }
+
+ private:
+  struct Sub {
+    SubscriptionId id;
+    RawHandler handler;
+    lcm::Subscription* lcm_sub = nullptr;
+  };
+  static void dispatch(const void* rbuf, const std::string& channel, Sub* sub);
+
+  std::string url_;
+  RecvBufCheck recv_buf_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::list<Sub> subs_;  // stable addresses: LCM keeps a pointer to each
+  SubscriptionId next_id_ = 0;
+  int64_t decode_errors_ = 0;
+  std::mutex publish_mutex_;
+  std::vector<uint8_t> publish_buf_;
+};
+
+template <class Msg>
+bool Transport::publish(const std::string& channel, const Msg& msg) {
+  std::lock_guard<std::mutex> lock(publish_mutex_);
+  const int size = msg.getEncodedSize();
+  if (static_cast<int>(publish_buf_.size()) < size) publish_buf_.resize(size);
+  if (msg.encode(publish_buf_.data(), 0, size) != size) return false;
+  return publishRaw(channel, publish_buf_.data(), size);
+}
+
+template <class Msg>
+Transport::SubscriptionId Transport::subscribe(const std::string& channel, std::function<void(const Msg&)> handler) {
+  return subscribeRaw(channel, [this, handler = std::move(handler)](const void* data, int size) {
+    // A fresh message each time: the generated decoder leaves zero-length arrays untouched, so a
+    // reused one could keep stale contents. Only rollout chunks are frequent enough to matter,
+    // and they take the raw path.
+    Msg msg;
+    int used = -1;
+    try {
+      used = msg.decode(data, 0, size);
+    } catch (const std::exception&) {  // hostile lengths: bad_alloc / length_error
+      used = -1;
+    }
+    if (used != size) {
+      ++decode_errors_;
+      return;
+    }
+    handler(msg);
+  });
+}
+
+}  // namespace masa::transport

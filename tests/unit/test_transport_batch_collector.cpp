@@ -1,0 +1,164 @@
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "common/transport/batch_collector.hpp"
+#include "common/transport/rollout_assembler.hpp"
+#include "common/transport/rollout_chunker.hpp"
+#include "test_transport_support.hpp"
+
+namespace masa::transport {
+namespace {
+
+using testing::fillRandomRollout;
+using testing::RolloutShape;
+
+constexpr RolloutShape kShape{6, 4, 5, 2};  // 6 envs x 4 steps, tiny dims
+constexpr int64_t kRun = 3;
+
+// Feeds rollouts of one actor through a real assembler into the collector under test.
+class Feeder {
+ public:
+  explicit Feeder(int lag) : assembler_(config(lag)) {}
+  static AssemblerConfig config(int lag) {
+    AssemblerConfig c;
+    c.run_id = kRun;
+    c.horizon = kShape.horizon;
+    c.obs_dim = kShape.obs_dim;
+    c.act_dim = kShape.act_dim;
+    c.max_policy_lag = lag;
+    c.warn_interval_s = -1;
+    return c;
+  }
+  void setLearnerVersion(int64_t v) { assembler_.setLearnerVersion(v); }
+  // Sends one rollout acted with `version`; returns the chunks accepted. Without events the
+  // rollout goes out as 3 chunks of 2 environments.
+  int send(BatchCollector& collector, int64_t version, double event_prob = 0.0) {
+    fillRandomRollout(rollout_, kShape, seq_, event_prob);
+    const int budget = RolloutChunker::emptyChunkBytes(kShape.act_dim, rollout_.term_names) +
+                       2 * RolloutChunker::envBytes(kShape.horizon, kShape.obs_dim, kShape.act_dim) + 100 +
+                       (event_prob > 0 ? 2000 : 0);
+    RolloutChunker chunker(budget);
+    int accepted = 0;
+    for (const auto& c : chunker.split(rollout_, {kRun, 0, seq_++, version})) {
+      const Verdict v = assembler_.accept(c);
+      if (v) {
+        collector.add(*v.chunk);
+        ++accepted;
+      }
+    }
+    return accepted;
+  }
+  const RolloutAssembler& assembler() const { return assembler_; }
+
+ private:
+  RolloutAssembler assembler_;
+  ActorRollout rollout_;
+  int64_t seq_ = 0;
+};
+
+CollectorConfig collectorConfig(int num_envs, int lag, int capacity = 0) {
+  CollectorConfig c;
+  c.num_envs = num_envs;
+  c.horizon = kShape.horizon;
+  c.obs_dim = kShape.obs_dim;
+  c.act_dim = kShape.act_dim;
+  c.max_policy_lag = lag;
+  c.capacity_envs = capacity;
+  c.term_names = {"forward_velocity", "alive"};
+  return c;
+}
+
+TEST(BatchCollector, EmitsABatchOnlyOnceEnoughEnvironmentsArrived) {
+  Feeder feeder(0);
+  BatchCollector collector(collectorConfig(10, 0));
+  RolloutBatch batch;
+  EXPECT_EQ(feeder.send(collector, 0), 3);
+  EXPECT_EQ(collector.bufferedEnvs(), 6);
+  EXPECT_FALSE(collector.ready());
+  EXPECT_FALSE(collector.take(batch));
+  EXPECT_EQ(feeder.send(collector, 0), 3);
+  ASSERT_TRUE(collector.ready());
+  ASSERT_TRUE(collector.take(batch));
+  EXPECT_EQ(batch.data.num_envs, 10);
+  EXPECT_EQ(batch.data.horizon, kShape.horizon);
+  EXPECT_EQ(collector.bufferedEnvs(), 2);  // the rest waits for the next batch
+  EXPECT_EQ(collector.stats().batches, 1);
+  // Arrival order: the first rollout's six environments, then four of the second.
+  for (int b = 0; b < 6; ++b) EXPECT_EQ(batch.env_index[b], b);
+  for (int b = 6; b < 10; ++b) EXPECT_EQ(batch.env_index[b], b - 6);
+}
+
+TEST(BatchCollector, LagZeroIsStrictlyOnPolicy) {
+  Feeder feeder(0);
+  BatchCollector collector(collectorConfig(6, 0));
+  feeder.setLearnerVersion(2);
+  collector.setLearnerVersion(2);
+  EXPECT_EQ(feeder.send(collector, 1), 0);  // one version behind: refused at the gate
+  EXPECT_EQ(feeder.assembler().stats()[DropReason::kTooOld], 3);
+  EXPECT_EQ(feeder.send(collector, 2), 3);
+  EXPECT_TRUE(collector.ready());
+  // The learner updates before taking them: they are now one version stale and are evicted.
+  collector.setLearnerVersion(3);
+  EXPECT_EQ(collector.bufferedEnvs(), 0);
+  EXPECT_EQ(collector.stats().envs_stale, 6);
+  EXPECT_FALSE(collector.ready());
+}
+
+TEST(BatchCollector, LagTwoMixesVersionsOldestFirstAndEvictsBeyondTheLag) {
+  Feeder feeder(2);
+  BatchCollector collector(collectorConfig(6, 2, /*capacity=*/24));
+  feeder.setLearnerVersion(4);
+  collector.setLearnerVersion(4);
+  EXPECT_EQ(feeder.send(collector, 4), 3);
+  EXPECT_EQ(feeder.send(collector, 2), 3);
+  EXPECT_EQ(feeder.send(collector, 1), 0);  // three behind
+  EXPECT_EQ(feeder.send(collector, 3), 3);
+  RolloutBatch batch;
+  ASSERT_TRUE(collector.take(batch));
+  EXPECT_EQ(batch.env_version, std::vector<int64_t>({2, 2, 2, 2, 2, 2}));
+  // Versions 3 and 4 remain; moving to 6 leaves only version 4 within the lag.
+  collector.setLearnerVersion(6);
+  EXPECT_EQ(collector.bufferedEnvs(), 6);
+  EXPECT_EQ(collector.stats().envs_stale, 6);
+  ASSERT_TRUE(collector.take(batch));
+  EXPECT_EQ(batch.env_version, std::vector<int64_t>(6, 4));
+}
+
+TEST(BatchCollector, FullPoolMakesRoomByEvictingOlderVersionsOnly) {
+  Feeder feeder(5);
+  BatchCollector collector(collectorConfig(6, 5, /*capacity=*/6));
+  feeder.setLearnerVersion(5);
+  collector.setLearnerVersion(5);
+  feeder.send(collector, 3);
+  feeder.send(collector, 3);  // pool full of version 3: these six cannot enter
+  EXPECT_EQ(collector.stats().envs_overflow, 6);
+  feeder.send(collector, 5);  // newer: replaces the version-3 environments
+  EXPECT_EQ(collector.stats().envs_overflow, 12);
+  RolloutBatch batch;
+  ASSERT_TRUE(collector.take(batch));
+  EXPECT_EQ(batch.env_version, std::vector<int64_t>(6, 5));
+}
+
+TEST(BatchCollector, EpisodesAndTruncationsFollowTheirEnvironmentIntoTheBatch) {
+  Feeder feeder(0);
+  BatchCollector collector(collectorConfig(6, 0));
+  feeder.send(collector, 0, 0.3);
+  RolloutBatch batch;
+  ASSERT_TRUE(collector.take(batch));
+  const ActorRollout& d = batch.data;
+  ASSERT_GT(d.numFinal(), 0);
+  ASSERT_GE(d.numEpisodes(), d.numFinal());
+  int truncated = 0;
+  for (int8_t x : d.truncated) truncated += x;
+  EXPECT_EQ(truncated, d.numFinal());
+  for (int i = 0; i < d.numFinal(); ++i) EXPECT_EQ(d.truncated[d.final_index[i]], 1);
+  for (int i = 0; i < d.numEpisodes(); ++i) {
+    EXPECT_GE(d.episode_env[i], 0);
+    EXPECT_LT(d.episode_env[i], 6);
+  }
+  EXPECT_EQ(d.episode_term_sums.size(), static_cast<std::size_t>(d.numEpisodes()) * 2);
+}
+
+}  // namespace
+}  // namespace masa::transport

@@ -1,0 +1,62 @@
+// Shared helpers of the transport tests: random rollouts with truncations and episodes, and
+// encoding a message to bytes as it would travel.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "common/transport/actor_rollout.hpp"
+
+namespace masa::transport::testing {
+
+struct RolloutShape {
+  int num_envs, horizon, obs_dim, act_dim;
+};
+inline constexpr RolloutShape kHumanoid{8, 32, 74, 21};
+inline constexpr RolloutShape kTrifinger{20, 16, 41, 9};
+
+// Random contents everywhere; about `event_prob` of the steps end an episode (half by the time
+// limit, with a final observation), each finished episode with two reward terms.
+inline void fillRandomRollout(ActorRollout& r, const RolloutShape& s, uint64_t seed, double event_prob = 0.05) {
+  r.allocate(s.num_envs, s.horizon, s.obs_dim, s.act_dim, {"forward_velocity", "alive"});
+  r.clearEvents();
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<float> normal;
+  std::uniform_real_distribution<double> uniform;
+  for (float& x : r.obs) x = normal(rng);
+  for (float& x : r.actions) x = normal(rng);
+  for (float& x : r.mean) x = normal(rng);
+  for (float& x : r.log_prob) x = normal(rng);
+  for (float& x : r.reward) x = normal(rng);
+  for (float& x : r.log_std) x = normal(rng);
+  std::vector<float> final_obs(s.obs_dim);
+  for (int t = 0; t < s.horizon; ++t) {
+    for (int e = 0; e < s.num_envs; ++e) {
+      const std::size_t i = r.step(t, e);
+      r.terminated[i] = 0;
+      r.truncated[i] = 0;
+      if (uniform(rng) >= event_prob) continue;
+      if (uniform(rng) < 0.5) {
+        r.truncated[i] = 1;
+        for (float& x : final_obs) x = normal(rng);
+        r.addFinal(t, e, final_obs.data());
+      } else {
+        r.terminated[i] = 1;
+      }
+      const float terms[2] = {normal(rng), normal(rng)};
+      const int8_t success = static_cast<int8_t>(static_cast<int>(uniform(rng) * 3) - 1);
+      r.addEpisode(e, normal(rng), 1 + static_cast<int>(uniform(rng) * 500), success, terms);
+    }
+  }
+}
+
+template <class Msg>
+std::vector<uint8_t> encode(const Msg& m) {
+  std::vector<uint8_t> buf(m.getEncodedSize());
+  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  return buf;
+}
+
+}  // namespace masa::transport::testing
