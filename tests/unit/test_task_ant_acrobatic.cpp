@@ -2,85 +2,38 @@
 // determinism, and the C4 symmetry of spec + model checked against the simulation.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <random>
+#include <string>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
 
-#include "common/task/symmetry_verifier.hpp"
+#include "task_test_support.hpp"
 
 namespace masa::task {
 namespace {
 
-const std::string kRoot = MASA_SOURCE_DIR;
-const std::string kSpecPath = kRoot + "/configs/specs/ant_acrobatic.yaml";
+using namespace masa::test;
 
-YAML::Node shippedEnv() { return YAML::Clone(YAML::LoadFile(kRoot + "/configs/tasks/ant_acrobatic.yaml")["env"]); }
-
-TaskFactory makeFactory(const YAML::Node& env = shippedEnv(),
-                        const sym::SymmetrySpec& spec = sym::SymmetrySpec::load(kSpecPath)) {
-  return TaskFactory("ant_acrobatic", spec, env);
-}
-
-// The shipped spec with `edit` applied to its YAML tree.
-template <class Edit>
-sym::SymmetrySpec editedSpec(Edit edit) {
-  YAML::Node root = YAML::LoadFile(kSpecPath);
-  edit(root);
-  YAML::Emitter out;
-  out << root;
-  return sym::SymmetrySpec::parseString(out.c_str(), "edited ant_acrobatic.yaml");
-}
-
-double* freeQpos(Task& t, const char* joint) {
-  const mjModel* m = t.model();
-  return t.data()->qpos + m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, joint)];
-}
-
-// Indices of observation entries by name (spec order).
-int obsIndex(const Task& t, const std::string& name) {
-  const auto& names = t.spec().obsNames();
-  for (int k = 0; k < static_cast<int>(names.size()); ++k)
-    if (names[k] == name) return k;
-  ADD_FAILURE() << "no observation " << name;
-  return 0;
-}
+const std::string kTask = "ant_acrobatic";
 
 TEST(AntAcrobaticTask, LoadsAndRuns1000RandomStepsWithFiniteValues) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   auto t = f.create();
   ASSERT_EQ(t->obsDim(), 58);
   ASSERT_EQ(t->actDim(), 8);
-  Rng rng(1);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<float> obs(t->obsDim()), act(t->actDim());
-  t->reset(rng);
   int episodes = 0;
-  for (int s = 0; s < 1000; ++s) {
-    for (float& a : act) a = u(rng);
-    const StepOutcome o = t->step(act.data());
-    t->observe(obs.data());
-    ASSERT_TRUE(std::isfinite(o.reward)) << "step " << s;
-    for (int d = 0; d < t->obsDim(); ++d) ASSERT_TRUE(std::isfinite(obs[d])) << t->spec().obsNames()[d];
-    if (o.terminated || o.truncated) {
-      ++episodes;
-      t->reset(rng);
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(runRandomSteps(*t, 1, 1000, episodes));
   EXPECT_GT(episodes, 0);  // random torques topple the pole
 }
 
 TEST(AntAcrobaticTask, ResetPutsAntOnBallWithUprightPoleAndCanonicalQuaternion) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   auto t = f.create();
   Rng rng(3);
   t->reset(rng);
-  std::vector<float> obs(t->obsDim());
-  t->observe(obs.data());
+  const std::vector<float> obs = observation(*t);
   EXPECT_NEAR(obs[obsIndex(*t, "central.pole_up[2]")], 1.0, 1e-9);
   EXPECT_GE(obs[obsIndex(*t, "central.torso_quat_w")], 0.0f);
   EXPECT_NEAR(obs[obsIndex(*t, "central.torso_pos[2]")] - obs[obsIndex(*t, "central.ball_pos[2]")], 1.41, 1e-6);
@@ -92,7 +45,7 @@ TEST(AntAcrobaticTask, ResetPutsAntOnBallWithUprightPoleAndCanonicalQuaternion) 
 
 // Leg k must be leg 0 rotated by +90k deg about z, exactly: body offsets and joint axes.
 TEST(AntAcrobaticTask, ModelLegsAreExactRotationsOfLegZero) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   const mjModel* m = f.model()->get();
   auto rot = [](const double* v, int k, double* out) {  // +90k deg about z
     double x = v[0], y = v[1];
@@ -129,12 +82,11 @@ TEST(AntAcrobaticTask, ModelLegsAreExactRotationsOfLegZero) {
 }
 
 TEST(AntAcrobaticTask, ZeroActionEarnsExactlyTheAliveBonus) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   auto t = f.create();
   Rng rng(4);
   t->reset(rng);
-  const std::vector<float> zero(t->actDim(), 0.0f);
-  const StepOutcome o = t->step(zero.data());
+  const StepOutcome o = stepZero(*t);
   ASSERT_FALSE(o.terminated);
   EXPECT_EQ(o.reward, 0.5);  // zero torque: no action cost and no power
   EXPECT_EQ(t->rewardTerms()[1], 0.0);
@@ -142,7 +94,7 @@ TEST(AntAcrobaticTask, ZeroActionEarnsExactlyTheAliveBonus) {
 }
 
 TEST(AntAcrobaticTask, ActionAndEnergyCostsFollowTheAppendix) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   auto t = f.create();
   Rng rng(5);
   t->reset(rng);
@@ -170,17 +122,16 @@ TEST(AntAcrobaticTask, ActionAndEnergyCostsFollowTheAppendix) {
 }
 
 TEST(AntAcrobaticTask, TiltedPoleTerminatesWithMinusOne) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   auto t = f.create();
   Rng rng(6);
   t->reset(rng);
-  double* q = freeQpos(*t, "pole_root");
+  double* q = jointQpos(*t, "pole_root");
   const double half = 0.5 * 15.0 * M_PI / 180.0;  // 15 deg about x: up_z = 0.966 < 0.98
   q[3] = std::cos(half);
   q[4] = std::sin(half);
   q[5] = q[6] = 0.0;
-  const std::vector<float> zero(t->actDim(), 0.0f);
-  const StepOutcome o = t->step(zero.data());
+  const StepOutcome o = stepZero(*t);
   EXPECT_TRUE(o.terminated);
   EXPECT_FALSE(o.truncated);
   EXPECT_EQ(o.reward, -1.0);
@@ -189,39 +140,34 @@ TEST(AntAcrobaticTask, TiltedPoleTerminatesWithMinusOne) {
 }
 
 TEST(AntAcrobaticTask, UprightPoleOutOfTheCupTerminates) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   auto t = f.create();
   Rng rng(7);
   t->reset(rng);
-  double* q = freeQpos(*t, "pole_root");
+  double* q = jointQpos(*t, "pole_root");
   q[0] = 3.0;  // standing upright on the floor beside the ball
   q[2] = 1.0;
-  const std::vector<float> zero(t->actDim(), 0.0f);
-  const StepOutcome o = t->step(zero.data());
-  std::vector<float> obs(t->obsDim());
-  t->observe(obs.data());
+  const StepOutcome o = stepZero(*t);
+  const std::vector<float> obs = observation(*t);
   EXPECT_GT(obs[obsIndex(*t, "central.pole_up[2]")], 0.98);  // not the tilt: the drop ends it
   EXPECT_TRUE(o.terminated);
   EXPECT_EQ(o.reward, -1.0);
 }
 
 TEST(AntAcrobaticTask, AntOffTheBallTerminates) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   auto t = f.create();
   Rng rng(8);
   t->reset(rng);
-  freeQpos(*t, "ball_root")[0] = 4.0;  // the ball rolls away from under the level ant
-  freeQpos(*t, "ball_root")[2] = 2.0;  // ... and sits level with the torso (0.41 m apart in z)
-  const std::vector<float> zero(t->actDim(), 0.0f);
-  const StepOutcome o = t->step(zero.data());
+  jointQpos(*t, "ball_root")[0] = 4.0;  // the ball rolls away from under the level ant
+  jointQpos(*t, "ball_root")[2] = 2.0;  // ... and sits level with the torso (0.41 m apart in z)
+  const StepOutcome o = stepZero(*t);
   EXPECT_TRUE(o.terminated);
   EXPECT_EQ(o.reward, -1.0);
 }
 
 TEST(AntAcrobaticTask, TimeLimitTruncatesWithoutPenalty) {
-  YAML::Node env = shippedEnv();
-  env["max_episode_steps"] = 5;
-  TaskFactory f = makeFactory(env);
+  TaskFactory f = envFactory(kTask, editedEnv(kTask, [](YAML::Node& env) { env["max_episode_steps"] = 5; }));
   auto t = f.create();
   Rng rng(9);
   t->reset(rng);
@@ -236,29 +182,10 @@ TEST(AntAcrobaticTask, TimeLimitTruncatesWithoutPenalty) {
   EXPECT_DOUBLE_EQ(t->episode().ret, 2.5);
 }
 
-std::vector<float> trajectory(std::uint64_t seed) {
-  TaskFactory f = makeFactory();
-  auto t = f.create();
-  Rng rng(seed);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<float> obs(t->obsDim()), act(t->actDim()), out;
-  t->reset(rng);
-  for (int s = 0; s < 100; ++s) {
-    for (float& a : act) a = u(rng);
-    const StepOutcome o = t->step(act.data());
-    t->observe(obs.data());
-    out.insert(out.end(), obs.begin(), obs.end());
-    out.push_back(static_cast<float>(o.reward));
-    if (o.terminated || o.truncated) t->reset(rng);
-  }
-  return out;
-}
-
 TEST(AntAcrobaticTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
-  const std::vector<float> a = trajectory(11), b = trajectory(11), c = trajectory(12);
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(float)));
-  EXPECT_NE(a, c);
+  const TrajectoryOptions opt{.steps = 100};
+  expectSameSeedBitIdenticalOtherSeedDiffers(
+      [&](std::uint64_t seed) { return recordTrajectory(envFactory(kTask), seed, opt); }, 11, 12);
 }
 
 // Tolerance: a 90 deg rotation maps the model onto itself exactly (exact leg coordinates, elliptic
@@ -269,15 +196,16 @@ TEST(AntAcrobaticTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
 // a wrong sign or a swapped leg gives errors of order 0.1-10.
 constexpr double kSymmetryTolerance = 1e-6;
 
+// The verifier on three states of the shipped task with `spec` in place of its own (a broken one).
+SymmetryReport verifyWithSpec(const sym::SymmetrySpec& spec, std::uint64_t seed) {
+  return verifySymmetry(envFactory(kTask, shippedEnv(kTask), spec),
+                        {.num_states = 3, .max_warmup_steps = 10, .seed = seed, .tolerance = kSymmetryTolerance});
+}
+
 TEST(AntAcrobaticTask, PhysicsSymmetryVerifierPasses) {
-  TaskFactory f = makeFactory();
-  SymmetryVerifierOptions opt;
-  opt.num_states = 12;
-  opt.max_warmup_steps = 40;
-  opt.steps = 2;
-  opt.seed = 21;
-  opt.tolerance = kSymmetryTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  TaskFactory f = envFactory(kTask);
+  const SymmetryReport r = verifySymmetry(
+      f, {.num_states = 12, .max_warmup_steps = 40, .steps = 2, .seed = 21, .tolerance = kSymmetryTolerance});
   std::printf("%s", r.summary(4).c_str());
   EXPECT_TRUE(r.passed()) << r.summary(8);
   EXPECT_EQ(r.termination_mismatches, 0);
@@ -290,66 +218,43 @@ TEST(AntAcrobaticTask, PhysicsSymmetryVerifierPasses) {
 // must name the ankle joints. The observation map alone cannot see this: the same wrong sign is
 // applied to the state and to the observation.
 TEST(AntAcrobaticTask, WrongAnkleSignsFailTheVerifierNamingTheAnkles) {
-  const sym::SymmetrySpec broken = editedSpec([](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
     for (const char* block : {"observation", "action"})
       for (YAML::Node e : root[block]["limb"])
         if (e["name"].as<std::string>().rfind("ankle", 0) == 0) e["limb_signs"] = std::vector<int>{1, -1, -1, 1};
   });
-  TaskFactory f = makeFactory(shippedEnv(), broken);
-  SymmetryVerifierOptions opt;
-  opt.num_states = 3;
-  opt.max_warmup_steps = 10;
-  opt.seed = 22;
-  opt.tolerance = kSymmetryTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  const SymmetryReport r = verifyWithSpec(broken, 22);
   EXPECT_FALSE(r.passed());
-  double worst_ankle = 0.0, worst_hip = 0.0;
-  for (const NamedError& e : r.joints) {
-    if (e.name.rfind("ankle_", 0) == 0) worst_ankle = std::max(worst_ankle, e.error);
-    if (e.name.rfind("hip_", 0) == 0) worst_hip = std::max(worst_hip, e.error);
-  }
+  const double worst_ankle = worstError(r.joints, [](const std::string& n) { return n.rfind("ankle_", 0) == 0; });
+  const double worst_hip = worstError(r.joints, [](const std::string& n) { return n.rfind("hip_", 0) == 0; });
   EXPECT_GT(worst_ankle, 0.1) << r.summary(8);  // pushed back from -80 deg towards +30 deg
   EXPECT_GT(worst_ankle, worst_hip) << r.summary(8);
 }
 
 // Swapping two legs in mujoco.actuators breaks the rotation: the hips are named.
 TEST(AntAcrobaticTask, SwappedLegBindingFailsTheVerifier) {
-  const sym::SymmetrySpec broken = editedSpec([](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
     YAML::Node limbs = root["mujoco"]["actuators"]["limbs"];
     const YAML::Node l1 = YAML::Clone(limbs[1]);
     limbs[1] = YAML::Clone(limbs[3]);
     limbs[3] = l1;
   });
-  TaskFactory f = makeFactory(shippedEnv(), broken);
-  SymmetryVerifierOptions opt;
-  opt.num_states = 3;
-  opt.max_warmup_steps = 10;
-  opt.seed = 23;
-  opt.tolerance = kSymmetryTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  const SymmetryReport r = verifyWithSpec(broken, 23);
   EXPECT_FALSE(r.passed());
-  double worst_root = 0.0;
-  for (const NamedError& e : r.joints)
-    if (e.name == "root") worst_root = e.error;
+  const double worst_root = worstError(r.joints, [](const std::string& n) { return n == "root"; });
   EXPECT_GT(worst_root, 1e-3) << r.summary(8);  // mirrored legs push the torso the wrong way
 }
 
 // A vector declared invariant: the observation map itself must fail, on the rotated components.
 TEST(AntAcrobaticTask, PoleUpDeclaredInvariantFailsTheObservationMap) {
-  const sym::SymmetrySpec broken = editedSpec([](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
     for (YAML::Node e : root["observation"]["central"])
       if (e["name"].as<std::string>() == "pole_up") {
         e["kind"] = "invariant";
         e["count"] = 3;
       }
   });
-  TaskFactory f = makeFactory(shippedEnv(), broken);
-  SymmetryVerifierOptions opt;
-  opt.num_states = 3;
-  opt.max_warmup_steps = 10;
-  opt.seed = 24;
-  opt.tolerance = kSymmetryTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  const SymmetryReport r = verifyWithSpec(broken, 24);
   EXPECT_FALSE(r.passed());
   for (const NamedError& e : r.observation_map) {
     if (e.name == "central.pole_up[0]" || e.name == "central.pole_up[1]")

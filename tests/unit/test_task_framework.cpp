@@ -3,14 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "common/core/config_error.hpp"
-#include "common/task/symmetry_verifier.hpp"
+#include "task_test_support.hpp"
 
 namespace masa::task {
 namespace {
+
+using namespace masa::test;
 
 const std::string kData = MASA_TEST_DATA_DIR;
 
@@ -81,12 +81,7 @@ MASA_REGISTER_TASK("twin_arm_test", "tests/data/twin_arm.xml", &makeTwinArm);
 
 sym::SymmetrySpec twinSpec() { return sym::SymmetrySpec::load(kData + "/twin_arm_spec.yaml"); }
 
-std::string specText() {
-  std::ifstream in(kData + "/twin_arm_spec.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string specText() { return readTextFile(kData + "/twin_arm_spec.yaml"); }
 
 TaskFactory factory(const std::string& env_yaml = "{}", const sym::SymmetrySpec& spec = twinSpec()) {
   return TaskFactory("twin_arm_test", spec, YAML::Load(env_yaml), {}, "test env");
@@ -95,22 +90,8 @@ TaskFactory factory(const std::string& env_yaml = "{}", const sym::SymmetrySpec&
 TEST(TaskFramework, ResetsAndRuns1000RandomStepsWithFiniteObservationsAndRewards) {
   auto f = factory("{max_episode_steps: 200}");
   auto t = f.create();
-  Rng rng(1);
-  std::uniform_real_distribution<float> u(-1, 1);
-  std::vector<float> obs(t->obsDim()), act(t->actDim());
-  t->reset(rng);
   int episodes = 0;
-  for (int s = 0; s < 1000; ++s) {
-    for (float& a : act) a = u(rng);
-    const StepOutcome o = t->step(act.data());
-    t->observe(obs.data());
-    for (float v : obs) ASSERT_TRUE(std::isfinite(v));
-    ASSERT_TRUE(std::isfinite(o.reward));
-    if (o.terminated || o.truncated) {
-      ++episodes;
-      t->reset(rng);
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(runRandomSteps(*t, 1, 1000, episodes));
   EXPECT_EQ(episodes, 5);  // 1000 steps of 200-step episodes
 }
 
@@ -156,20 +137,7 @@ TEST(TaskFramework, TerminationGivesExactlyMinusOneAndTimeoutTruncatesWithoutIt)
 
 TEST(TaskFramework, SameSeedGivesBitIdenticalTrajectoriesAndAnotherSeedDoesNot) {
   auto f = factory();
-  auto run = [&](std::uint64_t seed) {
-    auto t = f.create();
-    Rng rng(seed);
-    t->reset(rng);
-    std::uniform_real_distribution<float> u(-1, 1);
-    std::vector<float> obs(t->obsDim()), act(t->actDim()), all;
-    for (int s = 0; s < 100; ++s) {
-      for (float& a : act) a = u(rng);
-      t->step(act.data());
-      t->observe(obs.data());
-      all.insert(all.end(), obs.begin(), obs.end());
-    }
-    return all;
-  };
+  auto run = [&](std::uint64_t seed) { return recordTrajectory(f, seed, {.steps = 100, .record_reward = false}); };
   EXPECT_EQ(run(7), run(7));
   EXPECT_NE(run(7), run(8));
 }
@@ -189,11 +157,7 @@ TEST(TaskFramework, ApplyingTheMirrorTwiceRestoresTheState) {
 // Tolerance 1e-9: one step from mirrored states is the same computation with mirrored numbers,
 // so what differs is rounding and the constraint solver's iteration order (contact ordering).
 TEST(SymmetryVerifier, PassesOnTheCorrectSpec) {
-  SymmetryVerifierOptions opt;
-  opt.num_states = 10;
-  opt.steps = 3;
-  opt.tolerance = 1e-9;
-  const SymmetryReport r = verifySymmetry(factory(), opt);
+  const SymmetryReport r = verifySymmetry(factory(), {.num_states = 10, .steps = 3, .tolerance = 1e-9});
   EXPECT_TRUE(r.passed()) << r.summary();
   EXPECT_GT(r.joints.size(), 0u);
 }
@@ -210,8 +174,7 @@ TEST(SymmetryVerifier, NamesTheEntryWhoseSignIsWrong) {
   const auto broken = sym::SymmetrySpec::parseString(text, "broken.yaml");
   const SymmetryReport r = verifySymmetry(factory("{}", broken), {.num_states = 5});
   EXPECT_FALSE(r.passed());
-  auto worst = *std::max_element(r.joints.begin(), r.joints.end(),
-                                 [](const NamedError& a, const NamedError& b) { return a.error < b.error; });
+  const NamedError worst = worstEntry(r.joints);
   EXPECT_NE(worst.name.find("elbow"), std::string::npos) << r.summary();
   EXPECT_NE(r.summary().find("elbow"), std::string::npos);
 }
@@ -230,8 +193,11 @@ TEST(SymmetryVerifier, NamesTheJointsWhenActuatorsAreSwappedInsideALimb) {
   for (const NamedError& e : r.observation_map) {
     const bool arm = e.name.find("shoulder") != std::string::npos || e.name.find("elbow") != std::string::npos;
     const bool action = e.name.find("action") != std::string::npos;
-    if (!arm) EXPECT_LT(e.error, 1e-9) << e.name;
-    if (arm && !action && e.name.find("limb1") != std::string::npos) EXPECT_GT(e.error, 1e-3) << e.name;
+    if (!arm) {
+      EXPECT_LT(e.error, 1e-9) << e.name;
+    } else if (!action && e.name.find("limb1") != std::string::npos) {
+      EXPECT_GT(e.error, 1e-3) << e.name;
+    }
   }
 }
 

@@ -5,64 +5,25 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <random>
 #include <string>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
 
-#include "common/config/run_config.hpp"
-#include "common/task/symmetry_verifier.hpp"
+#include "task_test_support.hpp"
 
 namespace masa::task {
 namespace {
 
-const std::string kRoot = MASA_SOURCE_DIR;
-const std::string kSpecPath = kRoot + "/configs/specs/humanoid_tightrope.yaml";
+using namespace masa::test;
 
-YAML::Node shippedEnv() { return YAML::Clone(YAML::LoadFile(kRoot + "/configs/tasks/humanoid_tightrope.yaml")["env"]); }
-
-TaskFactory makeFactory(const YAML::Node& env = shippedEnv(),
-                        const sym::SymmetrySpec& spec = sym::SymmetrySpec::load(kSpecPath)) {
-  return TaskFactory("humanoid_tightrope", spec, env);
-}
+const std::string kTask = "humanoid_tightrope";
 
 // The shipped env without reset noise: hand-made states start from the exact start pose.
-TaskFactory quietFactory() {
-  YAML::Node env = shippedEnv();
-  env["reset_noise"] = 0.0;
-  return makeFactory(env);
+YAML::Node quietEnv() {
+  return editedEnv(kTask, [](YAML::Node& env) { env["reset_noise"] = 0.0; });
 }
-
-template <class Edit>
-sym::SymmetrySpec editedSpec(Edit edit) {
-  YAML::Node root = YAML::LoadFile(kSpecPath);
-  edit(root);
-  YAML::Emitter out;
-  out << root;
-  return sym::SymmetrySpec::parseString(out.c_str(), "edited humanoid_tightrope.yaml");
-}
-
-int termIndex(const Task& t, const std::string& term) {
-  const auto& n = t.rewardTermNames();
-  const auto it = std::find(n.begin(), n.end(), term);
-  EXPECT_NE(it, n.end()) << term;
-  return static_cast<int>(it - n.begin());
-}
-double term(const Task& t, const std::string& name) { return t.rewardTerms()[termIndex(t, name)]; }
-
-int obsIndex(const Task& t, const std::string& name) {
-  const auto& names = t.spec().obsNames();
-  const auto it = std::find(names.begin(), names.end(), name);
-  EXPECT_NE(it, names.end()) << name;
-  return static_cast<int>(it - names.begin());
-}
-
-StepOutcome stepZero(Task& t) {
-  const std::vector<float> zero(t.actDim(), 0.0f);
-  return t.step(zero.data());
-}
+TaskFactory quietFactory() { return envFactory(kTask, quietEnv()); }
 
 // Lifts the humanoid off the rope (no contact) and gives the root a world velocity.
 void floatWithVelocity(Task& t, double vx, double vy) {
@@ -75,40 +36,23 @@ void floatWithVelocity(Task& t, double vx, double vy) {
 }
 
 TEST(HumanoidTightropeTask, LoadsFromRunConfigAndRuns1000RandomStepsWithFiniteValues) {
-  const config::RunConfig rc = config::loadRunConfig(kRoot + "/configs", {"task=humanoid_tightrope"});
-  TaskFactory f("humanoid_tightrope", sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin);
+  const TaskFactory f = runConfigFactory(kTask);
   auto t = f.create();
   ASSERT_EQ(t->obsDim(), 74);
   ASSERT_EQ(t->actDim(), 21);
   EXPECT_EQ(t->maxEpisodeSteps(), 1000);
   EXPECT_NEAR(t->controlTimestep(), 0.015, 1e-12);
-  Rng rng(1);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<float> obs(t->obsDim()), act(t->actDim());
-  t->reset(rng);
   int episodes = 0;
-  for (int s = 0; s < 1000; ++s) {
-    for (float& a : act) a = u(rng);
-    const StepOutcome o = t->step(act.data());
-    t->observe(obs.data());
-    ASSERT_TRUE(std::isfinite(o.reward)) << "step " << s;
-    ASSERT_EQ(t->data()->warning[mjWARN_CONTACTFULL].number, 0) << "nconmax too small";
-    ASSERT_EQ(t->data()->warning[mjWARN_CNSTRFULL].number, 0) << "njmax too small";
-    for (int d = 0; d < t->obsDim(); ++d) ASSERT_TRUE(std::isfinite(obs[d])) << t->spec().obsNames()[d];
-    if (o.terminated || o.truncated) {
-      ++episodes;
-      t->reset(rng);
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(runRandomSteps(*t, 1, 1000, episodes, {.contact_buffers = true}));
   EXPECT_GT(episodes, 3);  // random torques make it fall off the rope within a second or so
 }
 
 // The left side is the numerical mirror image of the right one, and each left hinge axis is the
 // mirrored right axis times the sign the spec declares (odd: -1): the spec and the model agree.
 TEST(HumanoidTightropeTask, ModelLeftSideIsTheMirrorOfTheRightWithTheSpecsJointSigns) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   const mjModel* m = f.model()->get();
-  const sym::SymmetrySpec spec = sym::SymmetrySpec::load(kSpecPath);
+  const sym::SymmetrySpec spec = shippedSpec(kTask);
   const auto& right = spec.mujoco().limb_actuators[0];
   const auto& left = spec.mujoco().limb_actuators[1];
   const auto& kinds = spec.actionLayout().limb;
@@ -159,7 +103,7 @@ TEST(HumanoidTightropeTask, ModelLeftSideIsTheMirrorOfTheRightWithTheSpecsJointS
 }
 
 TEST(HumanoidTightropeTask, ResetStandsUprightWithAFootTouchingTheRopeTop) {
-  TaskFactory f = makeFactory();
+  TaskFactory f = envFactory(kTask);
   auto t = f.create();
   for (int seed = 0; seed < 5; ++seed) {
     Rng rng(seed);
@@ -176,8 +120,7 @@ TEST(HumanoidTightropeTask, ResetStandsUprightWithAFootTouchingTheRopeTop) {
       EXPECT_GT(d->contact[c].pos[2], 0.8 + 0.5 * 0.05) << "seed " << seed;
     }
     EXPECT_GE(rope_contacts, 1) << "seed " << seed;
-    std::vector<float> obs(t->obsDim());
-    t->observe(obs.data());
+    const std::vector<float> obs = observation(*t);
     EXPECT_NEAR(obs[obsIndex(*t, "central.torso_z")], 2.125, 0.02);
     EXPECT_NEAR(obs[obsIndex(*t, "central.torso_y")], 0.0, 1e-12);
     EXPECT_NEAR(obs[obsIndex(*t, "central.torso_roll")], 0.0, 1e-12);
@@ -192,13 +135,13 @@ TEST(HumanoidTightropeTask, StandingStillEarnsNoVelocityRewardButTheAliveUpAndHe
   t->reset(rng);
   const StepOutcome o = stepZero(*t);
   ASSERT_FALSE(o.terminated);
-  EXPECT_LT(std::abs(term(*t, "velocity")), 0.01);
-  EXPECT_EQ(term(*t, "alive"), 2.0);
-  EXPECT_EQ(term(*t, "up"), 0.1);
-  EXPECT_NEAR(term(*t, "heading"), 0.1, 1e-4);
-  EXPECT_EQ(term(*t, "action"), 0.0);  // zero action: no action or energy cost
-  EXPECT_EQ(term(*t, "energy"), 0.0);
-  EXPECT_EQ(term(*t, "termination"), 0.0);
+  EXPECT_LT(std::abs(rewardTerm(*t, "velocity")), 0.01);
+  EXPECT_EQ(rewardTerm(*t, "alive"), 2.0);
+  EXPECT_EQ(rewardTerm(*t, "up"), 0.1);
+  EXPECT_NEAR(rewardTerm(*t, "heading"), 0.1, 1e-4);
+  EXPECT_EQ(rewardTerm(*t, "action"), 0.0);  // zero action: no action or energy cost
+  EXPECT_EQ(rewardTerm(*t, "energy"), 0.0);
+  EXPECT_EQ(rewardTerm(*t, "termination"), 0.0);
   double sum = 0.0;
   for (double v : t->rewardTerms()) sum += v;
   EXPECT_DOUBLE_EQ(o.reward, sum);
@@ -212,13 +155,13 @@ TEST(HumanoidTightropeTask, VelocityRewardIsForwardSpeedAndLateralPenaltyIsSignl
     t->reset(rng);
     floatWithVelocity(*t, 0.8, vy);
     stepZero(*t);
-    EXPECT_NEAR(term(*t, "velocity"), 0.8, 0.02);  // weight 1.0; joint springs shift the torso a little
-    EXPECT_NEAR(term(*t, "lateral"), -0.3, 0.02);  // weight -1.0 on |v_y|, whichever side
+    EXPECT_NEAR(rewardTerm(*t, "velocity"), 0.8, 0.02);  // weight 1.0; joint springs shift the torso a little
+    EXPECT_NEAR(rewardTerm(*t, "lateral"), -0.3, 0.02);  // weight -1.0 on |v_y|, whichever side
   }
   t->reset(rng);
   floatWithVelocity(*t, -0.5, 0.0);
   stepZero(*t);
-  EXPECT_NEAR(term(*t, "velocity"), -0.5, 0.02);  // walking backwards costs
+  EXPECT_NEAR(rewardTerm(*t, "velocity"), -0.5, 0.02);  // walking backwards costs
 }
 
 TEST(HumanoidTightropeTask, HeadingAndUpFollowTheTorsoAxes) {
@@ -232,16 +175,16 @@ TEST(HumanoidTightropeTask, HeadingAndUpFollowTheTorsoAxes) {
   q[3] = std::sin(M_PI / 6);
   mj_forward(t->model(), t->data());
   stepZero(*t);
-  EXPECT_NEAR(term(*t, "heading"), 0.1 * 0.5, 1e-3);
-  EXPECT_EQ(term(*t, "up"), 0.1);
+  EXPECT_NEAR(rewardTerm(*t, "heading"), 0.1 * 0.5, 1e-3);
+  EXPECT_EQ(rewardTerm(*t, "up"), 0.1);
   t->reset(rng);
   floatWithVelocity(*t, 0.0, 0.0);
   q[0] = std::cos(M_PI / 12);  // roll 30 deg: torso z axis' world z = 0.866 < 0.93
   q[1] = std::sin(M_PI / 12);
   mj_forward(t->model(), t->data());
   stepZero(*t);
-  EXPECT_EQ(term(*t, "up"), 0.0);
-  EXPECT_NEAR(term(*t, "heading"), 0.1, 1e-3);
+  EXPECT_EQ(rewardTerm(*t, "up"), 0.0);
+  EXPECT_NEAR(rewardTerm(*t, "heading"), 0.1, 1e-3);
 }
 
 TEST(HumanoidTightropeTask, ActionAndEnergyCostsFollowTheAppendix) {
@@ -253,7 +196,7 @@ TEST(HumanoidTightropeTask, ActionAndEnergyCostsFollowTheAppendix) {
   for (int k = 0; k < t->actDim(); ++k) a[k] = (k % 2 ? 0.5f : -0.5f);
   a[0] = 3.0f;  // clamped to 1
   t->step(a.data());
-  EXPECT_NEAR(term(*t, "action"), -0.01 * (1.0 + 20 * 0.25), 1e-12);
+  EXPECT_NEAR(rewardTerm(*t, "action"), -0.01 * (1.0 + 20 * 0.25), 1e-12);
   // Energy: -0.05 * 0.2 * sum_k |a_k * qdot_k| over the actuated joints (Task::jointPower: the
   // electricity-cost convention the paper's weights were tuned for).
   const mjModel* m = t->model();
@@ -263,7 +206,7 @@ TEST(HumanoidTightropeTask, ActionAndEnergyCostsFollowTheAppendix) {
     power += 0.2 * std::abs(t->data()->ctrl[k] * t->data()->qvel[m->jnt_dofadr[j]]);
   }
   EXPECT_GT(power, 0.0);
-  EXPECT_NEAR(term(*t, "energy"), -0.05 * power, 1e-12);
+  EXPECT_NEAR(rewardTerm(*t, "energy"), -0.05 * power, 1e-12);
 }
 
 TEST(HumanoidTightropeTask, TorsoFallingBelowStartMinus075TerminatesWithExactlyMinusOne) {
@@ -283,53 +226,27 @@ TEST(HumanoidTightropeTask, TorsoFallingBelowStartMinus075TerminatesWithExactlyM
   EXPECT_TRUE(o.terminated);
   EXPECT_FALSE(o.truncated);
   EXPECT_EQ(o.reward, -1.0);
-  EXPECT_EQ(term(*t, "termination"), -1.0);
-  EXPECT_EQ(term(*t, "alive"), 0.0);
+  EXPECT_EQ(rewardTerm(*t, "termination"), -1.0);
+  EXPECT_EQ(rewardTerm(*t, "alive"), 0.0);
   EXPECT_TRUE(t->episode().terminated);
 }
 
 TEST(HumanoidTightropeTask, TimeLimitTruncatesWithoutPenalty) {
-  YAML::Node env = shippedEnv();
-  env["max_episode_steps"] = 5;
-  TaskFactory f = makeFactory(env);
+  TaskFactory f = envFactory(kTask, editedEnv(kTask, [](YAML::Node& env) { env["max_episode_steps"] = 5; }));
   auto t = f.create();
   Rng rng(0);
   t->reset(rng);
   StepOutcome o;
-  for (int s = 0; s < 5; ++s) {
-    o = stepZero(*t);
-    ASSERT_FALSE(o.terminated);
-    EXPECT_EQ(o.truncated, s == 4);
-  }
+  ASSERT_NO_FATAL_FAILURE(stepZeroToTimeLimit(*t, 5, o));
   EXPECT_GT(o.reward, 1.5);
-  EXPECT_EQ(term(*t, "termination"), 0.0);
+  EXPECT_EQ(rewardTerm(*t, "termination"), 0.0);
   EXPECT_EQ(t->episode().length, 5);
   EXPECT_TRUE(t->episode().truncated);
 }
 
-std::vector<float> trajectory(const TaskFactory& f, std::uint64_t seed) {
-  auto t = f.create();
-  Rng rng(seed);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<float> out, obs(t->obsDim()), act(t->actDim());
-  t->reset(rng);
-  for (int s = 0; s < 150; ++s) {
-    for (float& a : act) a = u(rng);
-    const StepOutcome o = t->step(act.data());
-    t->observe(obs.data());
-    out.insert(out.end(), obs.begin(), obs.end());
-    out.push_back(static_cast<float>(o.reward));
-    if (o.terminated || o.truncated) t->reset(rng);
-  }
-  return out;
-}
-
 TEST(HumanoidTightropeTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
-  TaskFactory f = makeFactory();
-  const std::vector<float> a = trajectory(f, 7), b = trajectory(f, 7), c = trajectory(f, 8);
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(float)));
-  EXPECT_NE(a, c);
+  TaskFactory f = envFactory(kTask);
+  expectSameSeedBitIdenticalOtherSeedDiffers([&](std::uint64_t seed) { return recordTrajectory(f, seed); }, 7, 8);
 }
 
 // Tolerance: the mirrored and the original simulations solve the same contact problem with the
@@ -338,13 +255,14 @@ TEST(HumanoidTightropeTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
 // gives errors of 1e-3 and more within one step, so 1e-8 separates the two by orders of magnitude.
 constexpr double kTolerance = 1e-8;
 
+// The verifier on a few states of the shipped task with `spec` in place of its own.
+SymmetryReport verifyWithSpec(const sym::SymmetrySpec& spec) {
+  return verifySymmetry(envFactory(kTask, shippedEnv(kTask), spec), {.num_states = 5, .tolerance = kTolerance});
+}
+
 TEST(HumanoidTightropeTask, PhysicsSymmetryVerifierPasses) {
-  TaskFactory f = makeFactory();
-  SymmetryVerifierOptions opt;
-  opt.num_states = 20;
-  opt.steps = 3;
-  opt.tolerance = kTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  TaskFactory f = envFactory(kTask);
+  const SymmetryReport r = verifySymmetry(f, {.num_states = 20, .steps = 3, .tolerance = kTolerance});
   EXPECT_TRUE(r.passed()) << r.summary();
   // The observation map obs(T s) = T obs(s) holds exactly (signs only) on every entry.
   for (const auto& e : r.observation_map) EXPECT_EQ(e.error, 0.0) << e.name;
@@ -352,15 +270,11 @@ TEST(HumanoidTightropeTask, PhysicsSymmetryVerifierPasses) {
 }
 
 TEST(HumanoidTightropeTask, AnkleXDeclaredInvariantFailsTheVerifierNamingTheAnkles) {
-  const sym::SymmetrySpec broken = editedSpec([](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
     for (YAML::Node e : root["action"]["limb"])
       if (e["name"].as<std::string>() == "ankle_x") e["kind"] = "invariant";
   });
-  TaskFactory f = makeFactory(shippedEnv(), broken);
-  SymmetryVerifierOptions opt;
-  opt.num_states = 5;
-  opt.tolerance = kTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  const SymmetryReport r = verifyWithSpec(broken);
   EXPECT_FALSE(r.passed());
   // The state map now keeps the ankle_x angles while the (odd) observation entries flip: the
   // observation map names exactly the six ankle_x entries.
@@ -382,16 +296,14 @@ TEST(HumanoidTightropeTask, AnkleXDeclaredInvariantFailsTheVerifierNamingTheAnkl
 // exact, so the dynamics must catch it; and since the noise-free start pose is mirror-symmetric, a
 // right T maps it onto itself, while the broken one moves exactly the swapped hip joints (x and z).
 TEST(HumanoidTightropeTask, HipsSwappedInTheActuatorBindingFailTheVerifier) {
-  const sym::SymmetrySpec broken = editedSpec([](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
     YAML::Node limb = root["mujoco"]["actuators"]["limbs"][1];
     const std::string x = limb[3].as<std::string>();
     limb[3] = limb[5].as<std::string>();  // left_hip_z where left_hip_x belongs
     limb[5] = x;
   });
-  YAML::Node quiet = shippedEnv();
-  quiet["reset_noise"] = 0.0;
   for (const bool is_broken : {false, true}) {
-    TaskFactory f = makeFactory(quiet, is_broken ? broken : sym::SymmetrySpec::load(kSpecPath));
+    TaskFactory f = envFactory(kTask, quietEnv(), is_broken ? broken : shippedSpec(kTask));
     auto t = f.create();
     Rng rng(0);
     t->reset(rng);
@@ -405,11 +317,7 @@ TEST(HumanoidTightropeTask, HipsSwappedInTheActuatorBindingFailTheVerifier) {
       EXPECT_EQ(moved, is_broken && swapped) << name;
     }
   }
-  TaskFactory f = makeFactory(shippedEnv(), broken);
-  SymmetryVerifierOptions opt;
-  opt.num_states = 5;
-  opt.tolerance = kTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  const SymmetryReport r = verifyWithSpec(broken);
   EXPECT_FALSE(r.passed());
   for (const auto& e : r.observation_map) EXPECT_EQ(e.error, 0.0) << e.name;
   for (const auto& e : r.joints) {
@@ -420,15 +328,11 @@ TEST(HumanoidTightropeTask, HipsSwappedInTheActuatorBindingFailTheVerifier) {
 }
 
 TEST(HumanoidTightropeTask, RollDeclaredInvariantFailsTheObservationMapNamingIt) {
-  const sym::SymmetrySpec broken = editedSpec([](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
     for (YAML::Node e : root["observation"]["central"])
       if (e["name"].as<std::string>() == "torso_roll") e["kind"] = "invariant";
   });
-  TaskFactory f = makeFactory(shippedEnv(), broken);
-  SymmetryVerifierOptions opt;
-  opt.num_states = 5;
-  opt.tolerance = kTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  const SymmetryReport r = verifyWithSpec(broken);
   EXPECT_FALSE(r.passed());
   for (const auto& e : r.observation_map) {
     if (e.name == "central.torso_roll") {

@@ -4,38 +4,23 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <random>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
-#include "common/config/run_config.hpp"
-#include "common/task/registry.hpp"
-#include "common/task/symmetry_verifier.hpp"
+#include "task_test_support.hpp"
 
 namespace masa::task {
 namespace {
 
-const std::string kSpec = std::string(MASA_SOURCE_DIR) + "/configs/specs/trifinger_lift.yaml";
+using namespace masa::test;
 
-TaskFactory makeFactory(const sym::SymmetrySpec& spec) {
-  const config::RunConfig rc = config::loadRunConfig(MASA_SOURCE_DIR "/configs", {"task=trifinger_lift"});
-  return TaskFactory("trifinger_lift", spec, rc.env, rc.origin);
-}
-
-TaskFactory makeFactory() { return makeFactory(sym::SymmetrySpec::load(kSpec)); }
-
-int termIndex(const Task& t, const std::string& name) {
-  const auto& n = t.rewardTermNames();
-  const auto it = std::find(n.begin(), n.end(), name);
-  EXPECT_NE(it, n.end()) << name;
-  return static_cast<int>(it - n.begin());
-}
+const std::string kTask = "trifinger_lift";
 
 double tipDistanceSum(const Task& t) {
   const mjModel* m = t.model();
-  const Eigen::Vector3d cube(t.data()->qpos + m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "cube")]);
+  const Eigen::Vector3d cube(t.data()->qpos + m->jnt_qposadr[jointId(t, "cube")]);
   double s = 0.0;
   for (int f = 0; f < 3; ++f) {
     const int g = mj_name2id(m, mjOBJ_GEOM, ("finger" + std::to_string(f) + "_tip").c_str());
@@ -46,41 +31,27 @@ double tipDistanceSum(const Task& t) {
 
 // Places the cube at the goal pose read from the observation (indices 7..13), shifted by `offset`.
 void putCubeAtGoal(Task& t, const Eigen::Vector3d& offset) {
-  std::vector<float> obs(t.obsDim());
-  t.observe(obs.data());
-  const mjModel* m = t.model();
-  const int j = mj_name2id(m, mjOBJ_JOINT, "cube");
-  double* q = t.data()->qpos + m->jnt_qposadr[j];
+  const std::vector<float> obs = observation(t);
+  double* q = jointQpos(t, "cube");
   for (int d = 0; d < 3; ++d) q[d] = obs[7 + d] + offset(d);
   for (int d = 0; d < 4; ++d) q[3 + d] = obs[10 + d];
-  std::fill(t.data()->qvel + m->jnt_dofadr[j], t.data()->qvel + m->jnt_dofadr[j] + 6, 0.0);
-  mj_forward(m, t.data());
+  std::fill(jointQvel(t, "cube"), jointQvel(t, "cube") + 6, 0.0);
+  mj_forward(t.model(), t.data());
 }
 
 TEST(TrifingerLift, LoadsAndRunsThousandRandomStepsWithFiniteValues) {
-  const TaskFactory f = makeFactory();
+  const TaskFactory f = runConfigFactory(kTask);
   auto t = f.create();
   ASSERT_EQ(t->obsDim(), 41);
   ASSERT_EQ(t->actDim(), 9);
   EXPECT_DOUBLE_EQ(t->controlTimestep(), 0.02);  // 50 Hz
   EXPECT_EQ(t->maxEpisodeSteps(), 750);
-  Rng rng(1);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<float> obs(41), act(9);
-  t->reset(rng);
-  for (int s = 0; s < 1000; ++s) {
-    for (float& a : act) a = u(rng);
-    const StepOutcome o = t->step(act.data());
-    t->observe(obs.data());
-    ASSERT_TRUE(std::isfinite(o.reward)) << "step " << s;
-    for (int d = 0; d < 41; ++d) ASSERT_TRUE(std::isfinite(obs[d])) << "step " << s << " dim " << d;
-    ASSERT_FALSE(o.terminated) << "step " << s;  // only a divergence terminates
-    if (o.truncated) t->reset(rng);
-  }
+  int episodes = 0;  // only the time limit ends one: a termination would be a divergence
+  ASSERT_NO_FATAL_FAILURE(runRandomSteps(*t, 1, 1000, episodes, {.never_terminates = true}));
 }
 
 TEST(TrifingerLift, FingersAndWallAreExactRotationsOfFingerZero) {
-  const TaskFactory f = makeFactory();
+  const TaskFactory f = runConfigFactory(kTask);
   auto t = f.create();
   const mjModel* m = t->model();
   mjData* d = t->data();
@@ -113,7 +84,7 @@ TEST(TrifingerLift, FingersAndWallAreExactRotationsOfFingerZero) {
 }
 
 TEST(TrifingerLift, CubeAtGoalSucceedsAndThreeCentimetresAwayDoesNot) {
-  const TaskFactory f = makeFactory();
+  const TaskFactory f = runConfigFactory(kTask);
   auto t = f.create();
   const std::vector<float> hold(9, 0.0f);
   for (int seed = 0; seed < 5; ++seed) {
@@ -124,7 +95,7 @@ TEST(TrifingerLift, CubeAtGoalSucceedsAndThreeCentimetresAwayDoesNot) {
     t->step(hold.data());  // one 20 ms step: the cube drops at most ~2 mm
     EXPECT_TRUE(t->episode().success) << "seed " << seed;
     // The keypoint kernel peaks at 1/4 per corner: weight 40 gives at most 10.
-    const double kp = t->rewardTerms()[termIndex(*t, "keypoints")];
+    const double kp = rewardTerm(*t, "keypoints");
     EXPECT_GT(kp, 9.5);
     EXPECT_LE(kp, 10.0);
 
@@ -132,12 +103,12 @@ TEST(TrifingerLift, CubeAtGoalSucceedsAndThreeCentimetresAwayDoesNot) {
     putCubeAtGoal(*t, Eigen::Vector3d(0.03, 0.0, 0.0));
     t->step(hold.data());
     EXPECT_FALSE(t->episode().success) << "seed " << seed;
-    EXPECT_LT(t->rewardTerms()[termIndex(*t, "keypoints")], 9.0);
+    EXPECT_LT(rewardTerm(*t, "keypoints"), 9.0);
   }
 }
 
 TEST(TrifingerLift, ReachTermRewardsTheDecreaseOfFingertipToCubeDistance) {
-  const TaskFactory f = makeFactory();
+  const TaskFactory f = runConfigFactory(kTask);
   auto t = f.create();
   Rng rng(3);
   t->reset(rng);
@@ -147,13 +118,13 @@ TEST(TrifingerLift, ReachTermRewardsTheDecreaseOfFingertipToCubeDistance) {
   t->step(inward.data());
   const double after = tipDistanceSum(*t);
   EXPECT_LT(after, before);
-  const double reach = t->rewardTerms()[termIndex(*t, "reach")];
+  const double reach = rewardTerm(*t, "reach");
   EXPECT_NEAR(reach, -15.0 * (after - before), 1e-12);
   EXPECT_GT(reach, 0.0);
 }
 
 TEST(TrifingerLift, EpisodeTruncatesAt750StepsWithoutTerminationPenalty) {
-  const TaskFactory f = makeFactory();
+  const TaskFactory f = runConfigFactory(kTask);
   auto t = f.create();
   Rng rng(4);
   t->reset(rng);
@@ -168,31 +139,14 @@ TEST(TrifingerLift, EpisodeTruncatesAt750StepsWithoutTerminationPenalty) {
   }
   EXPECT_TRUE(o.truncated);
   EXPECT_EQ(t->episode().length, 750);
-  EXPECT_EQ(t->rewardTerms()[termIndex(*t, "termination")], 0.0);
+  EXPECT_EQ(rewardTerm(*t, "termination"), 0.0);
   EXPECT_GT(o.reward, -1.0);
 }
 
-std::vector<float> trajectory(const TaskFactory& f, std::uint64_t seed) {
-  auto t = f.create();
-  Rng rng(seed);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<float> out, obs(41), act(9);
-  t->reset(rng);
-  for (int s = 0; s < 100; ++s) {
-    t->observe(obs.data());
-    out.insert(out.end(), obs.begin(), obs.end());
-    for (float& a : act) a = u(rng);
-    out.push_back(static_cast<float>(t->step(act.data()).reward));
-  }
-  return out;
-}
-
 TEST(TrifingerLift, SameSeedIsBitIdenticalDifferentSeedDiffers) {
-  const TaskFactory f = makeFactory();
-  const std::vector<float> a = trajectory(f, 7), b = trajectory(f, 7), c = trajectory(f, 8);
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
-  EXPECT_NE(a, c);
+  const TaskFactory f = runConfigFactory(kTask);
+  const TrajectoryOptions opt{.steps = 100, .observe = TrajectoryOptions::Observe::kBeforeStep};
+  expectSameSeedBitIdenticalOtherSeedDiffers([&](std::uint64_t seed) { return recordTrajectory(f, seed, opt); }, 7, 8);
 }
 
 // Observations are float: joint velocities reach ~25 rad/s, where one float ulp is ~2e-6, and two
@@ -202,16 +156,10 @@ TEST(TrifingerLift, SameSeedIsBitIdenticalDifferentSeedDiffers) {
 constexpr double kTolerance = 1e-5;
 
 TEST(TrifingerLift, PhysicsSymmetryCheckPassesAndObservationIsEquivariant) {
-  const TaskFactory f = makeFactory();
-  SymmetryVerifierOptions opt;
-  opt.num_states = 20;
-  opt.max_warmup_steps = 100;
-  opt.tolerance = kTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  const TaskFactory f = runConfigFactory(kTask);
+  const SymmetryReport r = verifySymmetry(f, {.num_states = 20, .max_warmup_steps = 100, .tolerance = kTolerance});
   EXPECT_TRUE(r.passed()) << r.summary(8);
-  double obs_map = 0.0;
-  for (const auto& e : r.observation_map) obs_map = std::max(obs_map, e.error);
-  EXPECT_LT(obs_map, kTolerance) << r.summary(8);
+  EXPECT_LT(worstError(r.observation_map), kTolerance) << r.summary(8);
   EXPECT_LT(r.reward_error, 1e-9) << r.summary(8);
   for (const auto& e : r.joints) EXPECT_LT(e.error, 1e-9) << e.name;
 }
@@ -220,16 +168,12 @@ TEST(TrifingerLift, PhysicsSymmetryCheckPassesAndObservationIsEquivariant) {
 // side), so claiming that fingers 1 and 2 measure it with the opposite sign must be refuted by the
 // simulation, naming an upper joint.
 TEST(TrifingerLift, FlippedUpperJointSignInTheSpecFailsTheCheckNamingIt) {
-  YAML::Node root = YAML::LoadFile(kSpec);
-  root["action"]["limb"][0]["limb_signs"] = YAML::Load("[1, -1, -1]");
-  const TaskFactory f = makeFactory(sym::SymmetrySpec::parse(root, "broken trifinger_lift"));
-  SymmetryVerifierOptions opt;
-  opt.num_states = 3;
-  opt.tolerance = kTolerance;
-  const SymmetryReport r = verifySymmetry(f, opt);
+  const TaskFactory f = runConfigFactory(kTask, editedSpec(kTask, [](YAML::Node& root) {
+    root["action"]["limb"][0]["limb_signs"] = YAML::Load("[1, -1, -1]");
+  }));
+  const SymmetryReport r = verifySymmetry(f, {.num_states = 3, .tolerance = kTolerance});
   ASSERT_FALSE(r.passed());
-  const auto worst = *std::max_element(r.joints.begin(), r.joints.end(),
-                                       [](const NamedError& a, const NamedError& b) { return a.error < b.error; });
+  const NamedError worst = worstEntry(r.joints);
   EXPECT_TRUE(worst.name == "finger0_upper" || worst.name == "finger2_upper") << r.summary(8);
   EXPECT_GT(worst.error, 1e-3);
 }
