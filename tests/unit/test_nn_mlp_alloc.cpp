@@ -1,57 +1,12 @@
-// Counts every heap allocation of the process by interposing malloc and friends (forwarding to
-// glibc's own entry points). operator new alone would miss Eigen, which allocates with malloc.
+// Checks that the MLP's training step allocates nothing, with the process-wide allocation counter
+// of alloc_counter.hpp.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstddef>
-#include <cstdlib>
 #include <memory>
 
+#include "alloc_counter.hpp"
 #include "common/nn/adam.hpp"
 #include "common/nn/mlp.hpp"
-
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || defined(__SANITIZE_MEMORY__)
-#define MASA_COUNT_MALLOC 0  // sanitizers own malloc
-#else
-#define MASA_COUNT_MALLOC 1
-#endif
-
-#if MASA_COUNT_MALLOC
-namespace {
-std::atomic<long> g_allocations{0};
-}
-
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void* __libc_memalign(std::size_t, std::size_t);
-void __libc_free(void*);
-
-void* malloc(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(n);
-}
-void* calloc(std::size_t n, std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(p, n);
-}
-void* aligned_alloc(std::size_t align, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_memalign(align, n);
-}
-int posix_memalign(void** out, std::size_t align, std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  *out = __libc_memalign(align, n);
-  return *out ? 0 : 12;  // ENOMEM
-}
-void free(void* p) { __libc_free(p); }
-}
-#endif
 
 namespace masa::nn {
 namespace {
@@ -59,13 +14,7 @@ namespace {
 // Keeps the compiler from eliding an allocation whose result is otherwise unused.
 void escape(void* p) { asm volatile("" : : "g"(p) : "memory"); }
 
-long allocations() {
-#if MASA_COUNT_MALLOC
-  return g_allocations.load();
-#else
-  return 0;
-#endif
-}
+long allocations() { return test::allocationCount(); }
 
 template <typename S>
 void expectNoAllocationInTrainingStep(const MlpShape& shape, int first_batch, int later_batch) {
@@ -99,9 +48,7 @@ void expectNoAllocationInTrainingStep(const MlpShape& shape, int first_batch, in
 }
 
 TEST(MlpAllocation, CounterSeesEigenAndNewAllocations) {
-#if !MASA_COUNT_MALLOC
-  GTEST_SKIP() << "malloc is owned by a sanitizer";
-#endif
+  if (!test::allocationCountingEnabled()) GTEST_SKIP() << "malloc is owned by a sanitizer";
   const long before = allocations();
   {
     Mat<float> m(17, 3);
@@ -115,9 +62,7 @@ TEST(MlpAllocation, CounterSeesEigenAndNewAllocations) {
 }
 
 TEST(MlpAllocation, NoneInForwardBackwardAdamAtTheSameOrSmallerBatch) {
-#if !MASA_COUNT_MALLOC
-  GTEST_SKIP() << "malloc is owned by a sanitizer";
-#endif
+  if (!test::allocationCountingEnabled()) GTEST_SKIP() << "malloc is owned by a sanitizer";
   MlpShape shape;
   shape.input = 11;
   shape.hidden = {40, 24};
@@ -127,9 +72,7 @@ TEST(MlpAllocation, NoneInForwardBackwardAdamAtTheSameOrSmallerBatch) {
 }
 
 TEST(MlpAllocation, NoneForTheHumanoidPolicyFromActorToMinibatchSizes) {
-#if !MASA_COUNT_MALLOC
-  GTEST_SKIP() << "malloc is owned by a sanitizer";
-#endif
+  if (!test::allocationCountingEnabled()) GTEST_SKIP() << "malloc is owned by a sanitizer";
   MlpShape shape;
   shape.input = 74;
   shape.hidden = {400, 200, 100};

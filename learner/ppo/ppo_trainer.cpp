@@ -1,0 +1,223 @@
+#include "learner/ppo/ppo_trainer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <utility>
+
+#include "common/core/check.hpp"
+
+namespace masa::ppo {
+namespace {
+
+PpoLossConfig lossConfig(const config::PpoConfig& c) {
+  PpoLossConfig l;
+  l.e_clip = c.e_clip;
+  l.entropy_coef = c.entropy_coef;
+  l.critic_coef = c.critic_coef;
+  l.bounds_loss_coef = c.bounds_loss_coef;
+  l.soft_bound = c.soft_bound;
+  l.clip_value = true;  // rl_games' clip_value, on in every task of the paper
+  return l;
+}
+
+// Flat 1 x T*E view of a T x E row-major matrix: the order of the obs columns.
+Eigen::Map<Mat<float>> flat(StepMat<float>& m) { return {m.data(), 1, m.size()}; }
+
+double mean(const float* x, Eigen::Index n) {
+  double s = 0;
+  for (Eigen::Index i = 0; i < n; ++i) s += x[i];
+  return n > 0 ? s / static_cast<double>(n) : 0.0;
+}
+
+double variance(const float* x, Eigen::Index n, double m) {  // population
+  double s = 0;
+  for (Eigen::Index i = 0; i < n; ++i) s += (x[i] - m) * (x[i] - m);
+  return n > 0 ? s / static_cast<double>(n) : 0.0;
+}
+
+}  // namespace
+
+PpoTrainer::PpoTrainer(model::ActorCritic<float>& model, nn::Adam<float>& adam, const config::PpoConfig& config)
+    : model_(&model),
+      adam_(&adam),
+      config_(config),
+      gae_{config.gamma, config.tau, config.value_bootstrap},
+      loss_(lossConfig(config), model.actDim(), config.minibatch_size),
+      lr_(parseLrSchedule(config.lr_schedule), config.learning_rate, config.kl_threshold, config.lr_min,
+          config.lr_max) {
+  MASA_CHECK(config.mini_epochs > 0, "mini_epochs must be positive, got " << config.mini_epochs);
+  const int m = config.minibatch_size, o = model.obsDim(), a = model.actDim();
+  mb_obs_.resize(o, m);
+  mb_actions_.resize(a, m);
+  mb_old_mean_.resize(a, m);
+  mb_old_log_prob_.resize(1, m);
+  mb_adv_.resize(1, m);
+  mb_old_value_.resize(1, m);
+  mb_returns_.resize(1, m);
+  log_std_.resize(a);
+  adam_->config().lr = static_cast<float>(lr_.lr());
+}
+
+PpoStats PpoTrainer::update(RolloutBuffer& buffer, Rng& rng) {
+  prepare(buffer);
+  return optimize(buffer, rng);
+}
+
+void PpoTrainer::resizeForBatch(const RolloutBuffer& buffer) {
+  MASA_CHECK(buffer.obsDim() == model_->obsDim() && buffer.actDim() == model_->actDim(),
+             "rollout buffer is obs " << buffer.obsDim() << " / act " << buffer.actDim() << ", model obs "
+                                      << model_->obsDim() << " / act " << model_->actDim());
+  const int n = buffer.size();
+  MASA_CHECK(n % config_.minibatch_size == 0, "batch of " << buffer.numEnvs() << " envs x " << buffer.horizon()
+                                                          << " steps = " << n << " is not a multiple of minibatch_size "
+                                                          << config_.minibatch_size);
+  if (n == batch_size_ && truncation_values_.cols() == buffer.numEnvs()) return;
+  batch_size_ = n;
+  old_values_.resize(1, n);
+  returns_.resize(1, n);
+  advantages_.resize(1, n);
+  truncation_values_.resize(buffer.horizon(), buffer.numEnvs());
+  bootstrap_values_.resize(buffer.numEnvs());
+  order_.resize(n);
+  for (int i = 0; i < n; ++i) order_[i] = i;
+}
+
+void PpoTrainer::evaluateValues(const ConstMatRef<float>& obs, float* out) {
+  const Eigen::Index n = obs.cols(), chunk = config_.minibatch_size;
+  for (Eigen::Index start = 0; start < n; start += chunk) {
+    const Eigen::Index len = std::min(chunk, n - start);
+    model_->forward(obs.middleCols(start, len));
+    const auto v = model_->value();
+    for (Eigen::Index i = 0; i < len; ++i) out[start + i] = v(0, i);
+  }
+}
+
+void PpoTrainer::prepare(RolloutBuffer& buffer) {
+  resizeForBatch(buffer);
+  if (config_.value_bootstrap) buffer.checkFinalObs();
+  model::ActorCritic<float>& model = *model_;
+
+  if (model.config().normalize_obs) model.obsNormalizer().update(buffer.obs());
+
+  // Critic values of everything GAE needs, then real units.
+  evaluateValues(buffer.obs(), buffer.values().data());
+  evaluateValues(buffer.bootstrapObs(), bootstrap_values_.data());
+  const int num_final = buffer.numFinalObs();
+  final_values_.resize(1, num_final);
+  if (num_final > 0) evaluateValues(buffer.finalObs(), final_values_.data());
+  if (config_.normalize_value) {
+    auto& vn = model.valueNormalizer();
+    auto values = flat(buffer.values());
+    vn.denormalize(values, values);
+    Eigen::Map<Mat<float>> boot(bootstrap_values_.data(), 1, bootstrap_values_.size());
+    vn.denormalize(boot, boot);
+    if (num_final > 0) vn.denormalize(final_values_, final_values_);
+  }
+  truncation_values_.setZero();
+  for (int k = 0; k < num_final; ++k) {
+    const FinalObsEntry& f = buffer.finalObsEntry(k);
+    truncation_values_(f.t, f.e) = final_values_(0, k);
+  }
+
+  computeGae<float>(gae_, buffer.rewards(), buffer.terminated(), buffer.truncated(), buffer.values(),
+                    truncation_values_, bootstrap_values_, buffer.advantages(), buffer.returns());
+
+  const Eigen::Index n = batch_size_;
+  const float* v = buffer.values().data();
+  const float* r = buffer.returns().data();
+  const float* a = buffer.advantages().data();
+  prepared_ = PpoStats{};
+  prepared_.mean_value = mean(v, n);
+  prepared_.mean_return = mean(r, n);
+  prepared_.mean_advantage = mean(a, n);
+  const double var_r = variance(r, n, prepared_.mean_return);
+  // R - V is the advantage.
+  prepared_.explained_variance = var_r > 0 ? 1.0 - variance(a, n, prepared_.mean_advantage) / var_r : 0.0;
+
+  // The critic trains on normalized targets; its old outputs are re-expressed with the new stats.
+  if (config_.normalize_value) {
+    auto& vn = model.valueNormalizer();
+    vn.update(flat(buffer.returns()));
+    vn.normalize(flat(buffer.values()), old_values_);
+    vn.normalize(flat(buffer.returns()), returns_);
+  } else {
+    old_values_ = flat(buffer.values());
+    returns_ = flat(buffer.returns());
+  }
+
+  advantages_ = flat(buffer.advantages());
+  if (config_.normalize_advantage) {
+    const double m = prepared_.mean_advantage;
+    const double sd = n > 1 ? std::sqrt(variance(a, n, m) * static_cast<double>(n) / static_cast<double>(n - 1)) : 0.0;
+    const float shift = static_cast<float>(m), scale = static_cast<float>(1.0 / (sd + 1e-8));
+    advantages_.array() = (advantages_.array() - shift) * scale;
+  }
+}
+
+PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
+  MASA_CHECK(buffer.size() == batch_size_, "optimize() on a buffer of " << buffer.size() << " samples, prepared "
+                                                                        << batch_size_);
+  model::ActorCritic<float>& model = *model_;
+  auto& params = model.params();
+  const int m = config_.minibatch_size;
+  const int per_epoch = batch_size_ / m;
+  const float max_norm = static_cast<float>(config_.grad_norm);
+  const Mat<float>& obs = buffer.obs();
+  const Mat<float>& actions = buffer.actions();
+  const Mat<float>& means = buffer.means();
+  const Mat<float>& log_probs = buffer.logProbs();
+  PpoStats st = prepared_;
+
+  for (int epoch = 0; epoch < config_.mini_epochs; ++epoch) {
+    // Fisher-Yates with the raw engine output: the same permutation on every standard library.
+    for (int i = batch_size_ - 1; i > 0; --i) std::swap(order_[i], order_[static_cast<int>(rng() % (i + 1))]);
+
+    for (int k = 0; k < per_epoch; ++k) {
+      const int* idx = order_.data() + static_cast<std::ptrdiff_t>(k) * m;
+      for (int j = 0; j < m; ++j) {
+        const int c = idx[j];
+        mb_obs_.col(j) = obs.col(c);
+        mb_actions_.col(j) = actions.col(c);
+        mb_old_mean_.col(j) = means.col(c);
+        mb_old_log_prob_(0, j) = log_probs(0, c);
+        mb_adv_(0, j) = advantages_(0, c);
+        mb_old_value_(0, j) = old_values_(0, c);
+        mb_returns_(0, j) = returns_(0, c);
+      }
+
+      model.forward(mb_obs_);
+      model.logStd(log_std_);
+      const PpoLossBatch<float> batch{model.mean(), log_std_,   model.value(), mb_actions_,   mb_old_log_prob_,
+                                      mb_old_mean_, buffer.logStd(), mb_adv_, mb_old_value_, mb_returns_};
+      const PpoLossStats ls = loss_.compute(batch);
+
+      params.zeroGrad();
+      model.backward(loss_.dmean(), loss_.dlogStd(), loss_.dvalue());
+      const double gn = max_norm > 0 ? nn::clipGradNorm(params, max_norm) : params.grads().norm();
+      adam_->config().lr = static_cast<float>(lr_.lr());
+      adam_->step();
+      lr_.update(ls.kl);
+
+      st.actor_loss += ls.actor_loss;
+      st.critic_loss += ls.critic_loss;
+      st.entropy += ls.entropy;
+      st.bounds_loss += ls.bounds_loss;
+      st.total_loss += ls.total_loss;
+      st.sym_policy_loss += model.symmetryPolicyLoss();
+      st.sym_value_loss += model.symmetryValueLoss();
+      st.kl += ls.kl;
+      st.clip_fraction += ls.clip_fraction;
+      st.grad_norm += gn;
+      ++st.minibatches;
+    }
+  }
+  const double inv = 1.0 / st.minibatches;
+  for (double* x : {&st.actor_loss, &st.critic_loss, &st.entropy, &st.bounds_loss, &st.total_loss,
+                    &st.sym_policy_loss, &st.sym_value_loss, &st.kl, &st.clip_fraction, &st.grad_norm})
+    *x *= inv;
+  st.lr = lr_.lr();
+  return st;
+}
+
+}  // namespace masa::ppo

@@ -1,0 +1,83 @@
+// One PPO update of an ActorCritic<float> from a full RolloutBuffer (rl_games' a2c_continuous
+// arrangement):
+//   prepare():  1. obs normalizer += the batch's observations (actors only read it; the learner
+//                  owns it and moves it once per batch, before anything is evaluated with it)
+//               2. critic values of the batch, the bootstrap and the time-outs' final observations,
+//                  denormalized to real units with the value normalizer as it was at collection
+//               3. GAE in real units; returns = advantages + values
+//               4. value normalizer += returns; old values and returns renormalized with it, so the
+//                  clipped value loss compares like with like
+//               5. advantages normalized by their batch mean and (unbiased) std
+//   optimize(): mini_epochs x shuffled minibatches: forward, loss, backward, grad-norm clip, Adam
+//               step, then the adaptive lr from that minibatch's KL(old || new) (measured before
+//               the step, as rl_games does). Allocates nothing once the sizes have been seen.
+// update() = prepare() + optimize().
+#pragma once
+
+#include <vector>
+
+#include "common/config/run_config.hpp"
+#include "common/model/actor_critic.hpp"
+#include "common/nn/adam.hpp"
+#include "learner/ppo/adaptive_lr.hpp"
+#include "learner/ppo/gae.hpp"
+#include "learner/ppo/ppo_loss.hpp"
+#include "learner/ppo/rollout_buffer.hpp"
+
+namespace masa::ppo {
+
+struct PpoStats {
+  // Means over the update's minibatches.
+  double actor_loss = 0, critic_loss = 0, entropy = 0, bounds_loss = 0, total_loss = 0;
+  double sym_policy_loss = 0, sym_value_loss = 0;  // SASA only (already weighted)
+  double kl = 0, clip_fraction = 0;
+  double grad_norm = 0;  // before clipping
+  // After the update.
+  double lr = 0;
+  // Of the batch, before the update, in real units.
+  double explained_variance = 0;  // 1 - Var(R - V) / Var(R)
+  double mean_value = 0, mean_return = 0, mean_advantage = 0;
+  int minibatches = 0;
+};
+
+class PpoTrainer {
+ public:
+  PpoTrainer(model::ActorCritic<float>& model, nn::Adam<float>& adam, const config::PpoConfig& config);
+
+  PpoStats update(RolloutBuffer& buffer, Rng& rng);
+
+  // The two halves of update(), separately callable (e.g. to measure the minibatch loop alone).
+  void prepare(RolloutBuffer& buffer);
+  PpoStats optimize(const RolloutBuffer& buffer, Rng& rng);
+
+  AdaptiveLr& learningRate() { return lr_; }
+  const AdaptiveLr& learningRate() const { return lr_; }
+  const config::PpoConfig& config() const { return config_; }
+
+ private:
+  void resizeForBatch(const RolloutBuffer& buffer);
+  // Critic values (normalized units) of obs columns, in chunks of at most minibatch_size.
+  void evaluateValues(const ConstMatRef<float>& obs, float* out);
+
+  model::ActorCritic<float>* model_;
+  nn::Adam<float>* adam_;
+  config::PpoConfig config_;
+  GaeConfig gae_;
+  PpoLoss<float> loss_;
+  AdaptiveLr lr_;
+  PpoStats prepared_;  // the batch statistics of the last prepare()
+
+  // Per batch (T*E samples, in the buffer's column order).
+  int batch_size_ = 0;
+  Mat<float> old_values_, returns_, advantages_;  // 1 x T*E, as the loss sees them
+  StepMat<float> truncation_values_;              // T x E
+  Vec<float> bootstrap_values_;                   // E
+  Mat<float> final_values_;                       // 1 x number of time-outs
+  std::vector<int> order_;                        // minibatch shuffle
+
+  // Per minibatch.
+  Mat<float> mb_obs_, mb_actions_, mb_old_mean_, mb_old_log_prob_, mb_adv_, mb_old_value_, mb_returns_;
+  Vec<float> log_std_;
+};
+
+}  // namespace masa::ppo
