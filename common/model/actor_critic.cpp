@@ -78,6 +78,7 @@ void ActorCritic<S>::forward(const ConstMatRef<S>& raw_obs) {
   mean_ptr_ = policy_.forward(obs).data();
   value_ptr_ = critic_.forward(obs).data();
   computeSymmetryLosses();
+  backward_ready_ = true;
 }
 
 template <typename S>
@@ -100,8 +101,20 @@ void ActorCritic<S>::logStd(VecRef<S> out) const {
 template <typename S>
 Eigen::Map<const Mat<S>> ActorCritic<S>::actMean(const ConstMatRef<S>& raw_obs) {
   normalizeInput(raw_obs);
+  backward_ready_ = false;
+  mean_ptr_ = value_ptr_ = nullptr;
   const S* p = policy_.forward(obs_normalized_.leftCols(batch_)).data();
   return Eigen::Map<const Mat<S>>(p, actDim(), batch_);
+}
+
+template <typename S>
+Eigen::Map<const Mat<S>> ActorCritic<S>::criticValue(const ConstMatRef<S>& raw_obs) {
+  normalizeInput(raw_obs);
+  backward_ready_ = false;
+  mean_ptr_ = value_ptr_ = nullptr;
+  // The first B columns are V(o) for every method (SASA appends its orbit copies after them).
+  const S* p = critic_.forward(obs_normalized_.leftCols(batch_)).data();
+  return Eigen::Map<const Mat<S>>(p, 1, batch_);
 }
 
 // SASA: the orbit copies are the stack's agents. Copy 0 is o itself; copy i is T_i o.
@@ -147,6 +160,7 @@ void ActorCritic<S>::computeSymmetryLosses() {
 
 template <typename S>
 void ActorCritic<S>::backward(const ConstMatRef<S>& dmean, const ConstVecRef<S>& dlog_std, const ConstMatRef<S>& dvalue) {
+  MASA_CHECK(backward_ready_, "backward() needs a forward() first (actMean/criticValue overwrite its caches)");
   MASA_CHECK(dvalue.rows() == 1 && dvalue.cols() == batch_, "dvalue must be 1 x " << batch_);
   log_std_.backward(dlog_std);
   if (config_.method == Method::kSasa) {

@@ -68,6 +68,9 @@ class ActorCritic {
 
   // Mean action only (for actors): no critic work.
   Eigen::Map<const Mat<S>> actMean(const ConstMatRef<S>& raw_obs);
+  // V(o) only (1 x B, normalized value units): no policy work. Like actMean, it overwrites the
+  // caches of forward(), so backward() must follow a fresh forward() (checked).
+  Eigen::Map<const Mat<S>> criticValue(const ConstMatRef<S>& raw_obs);
 
   // Parameters and normalizer statistics, for checkpoints.
   void save(std::ostream& os) const;
@@ -92,6 +95,7 @@ class ActorCritic {
   const S* value_ptr_ = nullptr;  // critic output of the last forward (1 x numPooled*B)
   const S* mean_ptr_ = nullptr;
   int batch_ = 0;
+  bool backward_ready_ = false;  // the last call was forward(): its caches are intact
   // SASA scratch: gradients on the orbit copies' actions and values, and residuals.
   std::vector<sym::SparseMap> act_t_transpose_;
   Mat<S> sym_dagent_, sym_residual_, dvalues_;

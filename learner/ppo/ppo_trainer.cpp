@@ -87,8 +87,7 @@ void PpoTrainer::evaluateValues(const ConstMatRef<float>& obs, float* out) {
   const Eigen::Index n = obs.cols(), chunk = config_.minibatch_size;
   for (Eigen::Index start = 0; start < n; start += chunk) {
     const Eigen::Index len = std::min(chunk, n - start);
-    model_->forward(obs.middleCols(start, len));
-    const auto v = model_->value();
+    const auto v = model_->criticValue(obs.middleCols(start, len));
     for (Eigen::Index i = 0; i < len; ++i) out[start + i] = v(0, i);
   }
 }

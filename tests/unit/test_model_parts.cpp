@@ -197,6 +197,45 @@ TEST(ActorCriticCheckpoint, SaveThenLoadGivesBitwiseIdenticalOutputs) {
   EXPECT_EQ(a.valueNormalizer().mean(), b.valueNormalizer().mean());
 }
 
+TEST(ActorCritic, CriticValueEqualsTheTrainingForwardsValueForEveryMethod) {
+  const auto spec = test::spec(test::kMirrorSpec, "mirror");
+  Rng rng(10);
+  const Mat<float> obs = test::randomMatrix<float>(spec.obsDim(), 6, rng);
+  for (Method method : {Method::kMasa, Method::kSa, Method::kSasa, Method::kMa}) {
+    ModelConfig cfg;
+    cfg.method = method;
+    cfg.policy_hidden = {8};
+    cfg.critic_hidden = {8, 4};
+    ActorCritic<float> m(spec, cfg);
+    m.initialize(rng);
+    m.forward(obs);
+    const Mat<float> full = m.value();
+    const Mat<float> only = m.criticValue(obs);
+    EXPECT_TRUE(full == only) << methodName(method);
+  }
+}
+
+TEST(ActorCritic, BackwardAfterActMeanOrCriticValueIsRefused) {
+  const auto spec = test::spec(test::kC3Spec, "c3");
+  ModelConfig cfg;
+  cfg.policy_hidden = {8};
+  cfg.critic_hidden = {8};
+  ActorCritic<float> m(spec, cfg);
+  Rng rng(11);
+  m.initialize(rng);
+  const Mat<float> obs = test::randomMatrix<float>(spec.obsDim(), 3, rng);
+  const Mat<float> dmean = Mat<float>::Zero(spec.actDim(), 3), dvalue = Mat<float>::Zero(1, 3);
+  const Vec<float> dls = Vec<float>::Zero(spec.actDim());
+  m.forward(obs);
+  m.criticValue(obs);
+  EXPECT_THROW(m.backward(dmean, dls, dvalue), std::invalid_argument);
+  m.forward(obs);
+  m.actMean(obs);
+  EXPECT_THROW(m.backward(dmean, dls, dvalue), std::invalid_argument);
+  m.forward(obs);
+  EXPECT_NO_THROW(m.backward(dmean, dls, dvalue));
+}
+
 TEST(ActorCriticCheckpoint, LoadingAnotherMethodFailsNamingBoth) {
   const auto spec = test::spec(test::kC3Spec, "c3");
   ModelConfig masa_cfg, sa_cfg;
