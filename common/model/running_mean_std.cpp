@@ -1,6 +1,7 @@
 #include "common/model/running_mean_std.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <istream>
 #include <ostream>
 #include <stdexcept>
@@ -103,6 +104,26 @@ template <typename S>
 void RunningMeanStd<S>::denormalize(const ConstMatRef<S>& in, MatRef<S> out) const {
   MASA_CHECK(in.rows() == dim_ && out.rows() == dim_ && in.cols() == out.cols(), "denormalize: shapes differ");
   out = (in.array().colwise() * scale_.array()).matrix().colwise() + shift_;
+}
+
+template <typename S>
+void RunningMeanStd<S>::setMeanStd(const float* mean, const float* std) {
+  for (int d = 0; d < dim_; ++d)
+    MASA_CHECK(std::isfinite(mean[d]) && std::isfinite(std[d]) && std[d] > 0.0f,
+               "setMeanStd: entry " << d << " has mean " << mean[d] << ", std " << std[d]);
+  for (int d = 0; d < dim_; ++d) {
+    const double sd = std[d];
+    mean_(d) = mean[d];
+    var_(d) = std::max(sd * sd - epsilon_, 0.0);  // so that save() keeps what is used
+  }
+  mean_eff_ = mean_;
+  var_eff_ = var_;
+  // The used shift and scale are exactly the broadcast values, not re-derived through var + eps.
+  for (int d = 0; d < dim_; ++d) {
+    shift_(d) = static_cast<S>(mean[d]);
+    scale_(d) = static_cast<S>(std[d]);
+    inv_scale_(d) = static_cast<S>(1.0 / static_cast<double>(std[d]));
+  }
 }
 
 template <typename S>

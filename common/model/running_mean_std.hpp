@@ -32,6 +32,10 @@ class RunningMeanStd {
   const Eigen::VectorXd& mean() const { return mean_eff_; }
   const Eigen::VectorXd& var() const { return var_eff_; }
 
+  // Replaces the statistics with a broadcast mean and std (std already includes epsilon, > 0), as
+  // an actor receives them from the learner; used as given, without symmetry projection.
+  void setMeanStd(const float* mean, const float* std);
+
   void save(std::ostream& os) const;
   void load(std::istream& is);  // throws std::runtime_error on a dimension mismatch or truncation
 

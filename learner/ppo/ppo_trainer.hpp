@@ -53,6 +53,9 @@ class PpoTrainer {
   AdaptiveLr& learningRate() { return lr_; }
   const AdaptiveLr& learningRate() const { return lr_; }
   const config::PpoConfig& config() const { return config_; }
+  // The minibatch shuffle carries over between updates (each shuffles the last permutation), so a
+  // checkpoint must hold it for a resumed run to repeat the same minibatches. Sized by prepare().
+  std::vector<int>& shuffleOrder() { return order_; }
 
  private:
   void resizeForBatch(const RolloutBuffer& buffer);

@@ -1,0 +1,388 @@
+#include "learner/learner.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/core/check.hpp"
+#include "common/symmetry/symmetry_spec.hpp"
+#include "common/transport/channels.hpp"
+#include "common/transport/drop_reason.hpp"
+#include "masa/lcmt_learner_stats.hpp"
+#include "masa/lcmt_policy_params.hpp"
+
+namespace masa::learner {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr char kCheckpointMagic[8] = {'M', 'A', 'S', 'A', 'C', 'K', 'P', '1'};
+// RunningMeanStd's default epsilon: the broadcast std is sqrt(var + eps), what the learner divides by.
+constexpr double kObsEps = 1e-5;
+
+template <class T>
+void writePod(std::ostream& os, const T& v) {
+  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+template <class T>
+T readPod(std::istream& is) {
+  T v{};
+  is.read(reinterpret_cast<char*>(&v), sizeof(T));
+  if (!is) throw std::runtime_error("checkpoint: truncated");
+  return v;
+}
+
+model::ModelConfig modelConfigOf(const config::RunConfig& rc) {
+  model::ModelConfig m = rc.model;
+  m.method = rc.method;  // the run's method is authoritative
+  return m;
+}
+
+int64_t randomRunId() {
+  // Clock-derived and mixed, so two learners started in the same second still differ.
+  uint64_t x = static_cast<uint64_t>(std::chrono::high_resolution_clock::now().time_since_epoch().count());
+  x ^= x >> 33;
+  x *= 0xff51afd7ed558ccdULL;
+  x ^= x >> 33;
+  return static_cast<int64_t>(x & 0x7fffffffffffffffULL) | 1;  // positive, never 0
+}
+
+transport::AssemblerConfig assemblerConfig(int64_t run_id, const config::RunConfig& rc, int obs_dim, int act_dim) {
+  transport::AssemblerConfig a;
+  a.run_id = run_id;
+  a.horizon = rc.ppo.horizon;
+  a.obs_dim = obs_dim;
+  a.act_dim = act_dim;
+  a.max_policy_lag = rc.ppo.max_policy_lag;
+  return a;
+}
+
+}  // namespace
+
+Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
+    : rc_(rc),
+      opt_(options),
+      dir_(options.run_dir),
+      rng_(rc.seed) {
+  MASA_CHECK(!dir_.empty(), "learner: no run directory");
+  fs::create_directories(dir_);
+  const auto spec = sym::SymmetrySpec::load(rc_.spec_path);
+  model_ = std::make_unique<model::ActorCritic<float>>(spec, modelConfigOf(rc_));
+  model_->initialize(rng_);
+  nn::AdamConfig<float> adam_cfg;
+  adam_cfg.lr = static_cast<float>(rc_.ppo.learning_rate);
+  adam_ = std::make_unique<nn::Adam<float>>(model_->params(), adam_cfg);
+  trainer_ = std::make_unique<ppo::PpoTrainer>(*model_, *adam_, rc_.ppo);
+  buffer_ = std::make_unique<ppo::RolloutBuffer>(rc_.ppo.num_envs, rc_.ppo.horizon, model_->obsDim(), model_->actDim());
+
+  run_id_ = options.run_id;
+  if (opt_.resume) {
+    loadCheckpoint();  // sets run_id_ unless one was given
+  } else {
+    std::ofstream(fs::path(dir_) / "config.yaml") << config::dumpResolved(rc_);
+  }
+  if (run_id_ == 0) run_id_ = randomRunId();
+  assembler_ = std::make_unique<transport::RolloutAssembler>(assemblerConfig(run_id_, rc_, model_->obsDim(), model_->actDim()));
+  assembler_->setLearnerVersion(version_);
+
+  transport_ = std::make_unique<transport::Transport>(opt_.url);
+  transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
+
+  start_ = last_update_ = std::chrono::steady_clock::now();
+  publishParams();
+}
+
+Learner::~Learner() = default;
+
+double Learner::wallTime() const {
+  return wall_offset_s_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+int64_t Learner::droppedTotal() const {
+  int64_t n = assembler_->stats().dropped();
+  if (collector_) n += collector_->stats().envs_stale + collector_->stats().envs_overflow;
+  return n;
+}
+
+void Learner::onChunk(const void* data, int size) {
+  const transport::Verdict v = assembler_->acceptEncoded(data, size);
+  if (!v) return;  // counted by the assembler
+  const auto& m = v.chunk->msg();
+  if (!collector_) {
+    transport::CollectorConfig c;
+    c.num_envs = rc_.ppo.num_envs;
+    c.horizon = rc_.ppo.horizon;
+    c.obs_dim = model_->obsDim();
+    c.act_dim = model_->actDim();
+    c.max_policy_lag = rc_.ppo.max_policy_lag;
+    c.term_names = m.term_names;
+    collector_ = std::make_unique<transport::BatchCollector>(c);
+    collector_->setLearnerVersion(version_);
+  }
+  collector_->add(*v.chunk);
+}
+
+bool Learner::step(int timeout_ms) {
+  transport_->handleTimeout(timeout_ms);
+  transport_->drain();
+  bool updated = false;
+  if (collector_ && collector_->take(batch_)) {
+    update(batch_);
+    updated = true;
+  }
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - last_publish_).count() >= opt_.republish_interval_s) publishParams();
+  return updated;
+}
+
+void Learner::run(int64_t max_updates, const std::atomic<bool>* stop) {
+  while (epoch_ < max_updates && !(stop && stop->load())) step(100);
+  writeCheckpoint();
+}
+
+void Learner::fillBuffer(const transport::ActorRollout& d) {
+  ppo::RolloutBuffer& b = *buffer_;
+  const int E = d.num_envs, T = d.horizon, od = d.obs_dim, ad = d.act_dim;
+  MASA_CHECK(E == b.numEnvs() && T == b.horizon() && od == b.obsDim() && ad == b.actDim(),
+             "batch shape differs from the rollout buffer");
+  const std::size_t steps = static_cast<std::size_t>(T) * E;
+  // Both layouts are step-major (column t*E + e), so each array is one copy.
+  std::memcpy(b.obs().data(), d.obs.data(), steps * od * sizeof(float));
+  std::memcpy(b.bootstrapObs().data(), d.obsAt(T, 0), static_cast<std::size_t>(E) * od * sizeof(float));
+  std::memcpy(b.actions().data(), d.actions.data(), steps * ad * sizeof(float));
+  std::memcpy(b.means().data(), d.mean.data(), steps * ad * sizeof(float));
+  std::memcpy(b.logProbs().data(), d.log_prob.data(), steps * sizeof(float));
+  std::memcpy(b.rewards().data(), d.reward.data(), steps * sizeof(float));
+  for (std::size_t i = 0; i < steps; ++i) {
+    b.terminated().data()[i] = d.terminated[i] != 0;
+    b.truncated().data()[i] = d.truncated[i] != 0;
+  }
+  // One behaviour log-std per batch (environment 0's): exact when max_policy_lag = 0.
+  for (int k = 0; k < ad; ++k) b.logStd()(k) = d.log_std[k];
+  b.clear();
+  for (int i = 0; i < d.numFinal(); ++i) {
+    const int idx = d.final_index[i];
+    b.addFinalObs(idx / E, idx % E, Eigen::Map<const Mat<float>>(d.final_obs.data() + static_cast<std::size_t>(i) * od, od, 1));
+  }
+  b.checkFinalObs();
+}
+
+void Learner::summarizeEpisodes(const transport::ActorRollout& d) {
+  const int n = d.numEpisodes(), K = d.numTerms();
+  report_.num_episodes = n;
+  report_.mean_return = report_.mean_length = 0;
+  report_.term_means.assign(K, 0.0);
+  int measured = 0, succeeded = 0;
+  for (int i = 0; i < n; ++i) {
+    report_.mean_return += d.episode_return[i];
+    report_.mean_length += d.episode_length[i];
+    if (d.episode_success[i] >= 0) {
+      ++measured;
+      succeeded += d.episode_success[i] == 1;
+    }
+    for (int k = 0; k < K; ++k) report_.term_means[k] += d.episode_term_sums[static_cast<std::size_t>(i) * K + k];
+  }
+  if (n > 0) {
+    report_.mean_return /= n;
+    report_.mean_length /= n;
+    for (double& t : report_.term_means) t /= n;
+  }
+  report_.success_rate = measured > 0 ? static_cast<double>(succeeded) / measured : -1.0;
+}
+
+void Learner::update(const transport::RolloutBatch& batch) {
+  fillBuffer(batch.data);
+  trainer_->prepare(*buffer_);
+  if (!restored_order_.empty()) {
+    // A resumed run continues the shuffle of the run it resumes (see PpoTrainer::shuffleOrder).
+    if (restored_order_.size() == trainer_->shuffleOrder().size()) trainer_->shuffleOrder() = restored_order_;
+    restored_order_.clear();
+  }
+  report_.ppo = trainer_->optimize(*buffer_, rng_);
+
+  const auto now = std::chrono::steady_clock::now();
+  const double dt = std::chrono::duration<double>(now - last_update_).count();
+  last_update_ = now;
+  const int64_t steps = static_cast<int64_t>(buffer_->size());
+  env_steps_ += steps;
+  report_.epoch = epoch_;
+  ++epoch_;
+  ++version_;
+  report_.version = version_;
+  report_.env_steps = env_steps_;
+  report_.wall_time_s = wallTime();
+  report_.fps = dt > 0 ? steps / dt : 0.0;
+  summarizeEpisodes(batch.data);
+  report_.dropped = droppedTotal();
+
+  assembler_->setLearnerVersion(version_);
+  collector_->setLearnerVersion(version_);
+  publishParams();
+  publishStats();
+  appendCsv();
+  if (opt_.verbose) {
+    std::printf("epoch %lld  v%lld  steps %lld  fps %.0f  return %.3f  len %.1f  success %.2f  kl %.5f  lr %.2e  "
+                "actor %.4f  critic %.4f  dropped %lld\n",
+                static_cast<long long>(report_.epoch), static_cast<long long>(version_),
+                static_cast<long long>(env_steps_), report_.fps, report_.mean_return, report_.mean_length,
+                report_.success_rate, report_.ppo.kl, report_.ppo.lr, report_.ppo.actor_loss, report_.ppo.critic_loss,
+                static_cast<long long>(report_.dropped));
+    std::fflush(stdout);
+  }
+  if (opt_.checkpoint_every > 0 && epoch_ % opt_.checkpoint_every == 0) writeCheckpoint();
+}
+
+void Learner::publishParams() {
+  masa::lcmt_policy_params m;
+  m.run_id = run_id_;
+  m.utime = transport::wallClockMicros();
+  m.version = version_;
+  m.method = model::methodName(rc_.method);
+  m.task = rc_.task;
+  const auto& p = model_->params().values();
+  m.num_params = static_cast<int32_t>(p.size());
+  m.params.assign(p.data(), p.data() + p.size());
+  if (model_->config().normalize_obs) {
+    auto& norm = model_->obsNormalizer();
+    m.obs_dim = norm.dim();
+    m.obs_mean.resize(norm.dim());
+    m.obs_std.resize(norm.dim());
+    for (int d = 0; d < norm.dim(); ++d) {
+      m.obs_mean[d] = static_cast<float>(norm.mean()(d));
+      m.obs_std[d] = static_cast<float>(std::sqrt(norm.var()(d) + kObsEps));
+    }
+  } else {
+    m.obs_dim = 0;
+  }
+  transport_->publish(transport::kPolicyChannel, m);
+  last_publish_ = std::chrono::steady_clock::now();
+}
+
+void Learner::publishStats() {
+  masa::lcmt_learner_stats s;
+  s.run_id = run_id_;
+  s.utime = transport::wallClockMicros();
+  s.epoch = report_.epoch;
+  s.version = report_.version;
+  s.env_steps = report_.env_steps;
+  s.fps = static_cast<float>(report_.fps);
+  s.mean_episode_return = static_cast<float>(report_.mean_return);
+  s.mean_episode_length = static_cast<float>(report_.mean_length);
+  s.success_rate = static_cast<float>(report_.success_rate);
+  s.num_episodes = report_.num_episodes;
+  const ppo::PpoStats& p = report_.ppo;
+  s.actor_loss = static_cast<float>(p.actor_loss);
+  s.critic_loss = static_cast<float>(p.critic_loss);
+  s.entropy = static_cast<float>(p.entropy);
+  s.bounds_loss = static_cast<float>(p.bounds_loss);
+  s.symmetry_policy_loss = static_cast<float>(p.sym_policy_loss);
+  s.symmetry_value_loss = static_cast<float>(p.sym_value_loss);
+  s.kl = static_cast<float>(p.kl);
+  s.learning_rate = static_cast<float>(p.lr);
+  s.grad_norm = static_cast<float>(p.grad_norm);
+  s.explained_variance = static_cast<float>(p.explained_variance);
+  // Assembler reasons (chunks), then the collector's own drops (environments).
+  for (int r = 1; r < transport::kNumDropReasons; ++r) {
+    s.drop_reason_names.emplace_back(transport::dropReasonName(static_cast<transport::DropReason>(r)));
+    s.drop_counts.push_back(assembler_->stats().count[r]);
+  }
+  s.drop_reason_names.emplace_back("stale_in_collector");
+  s.drop_counts.push_back(collector_ ? collector_->stats().envs_stale : 0);
+  s.drop_reason_names.emplace_back("overflow_in_collector");
+  s.drop_counts.push_back(collector_ ? collector_->stats().envs_overflow : 0);
+  s.num_drop_reasons = static_cast<int32_t>(s.drop_counts.size());
+  if (collector_) s.term_names = collector_->config().term_names;
+  s.num_terms = static_cast<int32_t>(s.term_names.size());
+  for (int k = 0; k < s.num_terms; ++k)
+    s.term_means.push_back(k < static_cast<int>(report_.term_means.size()) ? static_cast<float>(report_.term_means[k]) : 0.0f);
+  transport_->publish(transport::kLearnerStatsChannel, s);
+}
+
+void Learner::appendCsv() {
+  const fs::path path = fs::path(dir_) / "metrics.csv";
+  const bool fresh = !fs::exists(path) || fs::file_size(path) == 0;
+  std::ofstream f(path, std::ios::app);
+  if (fresh) {
+    f << "epoch,version,env_steps,wall_time_s,fps,return,length,success";
+    if (collector_)
+      for (const auto& t : collector_->config().term_names) f << ",term_" << t;
+    f << ",actor_loss,critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped\n";
+  }
+  const ppo::PpoStats& p = report_.ppo;
+  f.precision(9);
+  f << report_.epoch << ',' << report_.version << ',' << report_.env_steps << ',' << report_.wall_time_s << ','
+    << report_.fps << ',' << report_.mean_return << ',' << report_.mean_length << ',' << report_.success_rate;
+  for (double t : report_.term_means) f << ',' << t;
+  f << ',' << p.actor_loss << ',' << p.critic_loss << ',' << p.entropy << ',' << p.bounds_loss << ','
+    << p.sym_policy_loss << ',' << p.sym_value_loss << ',' << p.kl << ',' << p.lr << ',' << p.grad_norm << ','
+    << p.explained_variance << ',' << report_.dropped << '\n';
+}
+
+void Learner::writeCheckpoint() {
+  const fs::path path = fs::path(dir_) / "checkpoint.bin";
+  const fs::path tmp = fs::path(dir_) / "checkpoint.bin.tmp";
+  {
+    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+    os.write(kCheckpointMagic, sizeof(kCheckpointMagic));
+    writePod(os, run_id_);
+    writePod(os, epoch_);
+    writePod(os, version_);
+    writePod(os, env_steps_);
+    writePod(os, wallTime());
+    writePod(os, trainer_->learningRate().lr());
+    std::ostringstream rng_text;
+    rng_text << rng_;
+    const std::string r = rng_text.str();
+    writePod(os, static_cast<uint64_t>(r.size()));
+    os.write(r.data(), static_cast<std::streamsize>(r.size()));
+    const auto& order = trainer_->shuffleOrder();
+    writePod(os, static_cast<uint64_t>(order.size()));
+    os.write(reinterpret_cast<const char*>(order.data()), static_cast<std::streamsize>(order.size() * sizeof(int)));
+    model_->save(os);
+    adam_->save(os);
+    os.flush();
+    if (!os) throw std::runtime_error("checkpoint: cannot write " + tmp.string());
+  }
+  fs::rename(tmp, path);  // atomic on POSIX: a crash leaves the old or the new checkpoint, never half
+}
+
+void Learner::loadCheckpoint() {
+  const fs::path path = fs::path(dir_) / "checkpoint.bin";
+  std::ifstream is(path, std::ios::binary);
+  if (!is) throw std::runtime_error("resume: cannot open " + path.string());
+  char magic[sizeof(kCheckpointMagic)];
+  is.read(magic, sizeof(magic));
+  if (!is || std::memcmp(magic, kCheckpointMagic, sizeof(magic)) != 0)
+    throw std::runtime_error("resume: " + path.string() + " is not a masa learner checkpoint");
+  const int64_t run_id = readPod<int64_t>(is);
+  if (run_id_ == 0) run_id_ = run_id;  // keep the run: its actors go on being accepted
+  epoch_ = readPod<int64_t>(is);
+  version_ = readPod<int64_t>(is);
+  env_steps_ = readPod<int64_t>(is);
+  wall_offset_s_ = readPod<double>(is);
+  const double lr = readPod<double>(is);
+  const uint64_t rn = readPod<uint64_t>(is);
+  if (rn > (1u << 20)) throw std::runtime_error("resume: corrupt rng state");
+  std::string r(rn, '\0');
+  is.read(r.data(), static_cast<std::streamsize>(rn));
+  std::istringstream rng_text(r);
+  rng_text >> rng_;
+  if (!is || !rng_text) throw std::runtime_error("resume: corrupt rng state");
+  const uint64_t on = readPod<uint64_t>(is);
+  if (on > (1ull << 31)) throw std::runtime_error("resume: corrupt shuffle order");
+  restored_order_.resize(on);
+  is.read(reinterpret_cast<char*>(restored_order_.data()), static_cast<std::streamsize>(on * sizeof(int)));
+  if (!is) throw std::runtime_error("checkpoint: truncated");
+  model_->load(is, path.string());
+  adam_->load(is);
+  trainer_->learningRate().setLr(lr);
+  adam_->config().lr = static_cast<float>(lr);
+}
+
+}  // namespace masa::learner

@@ -1,0 +1,116 @@
+// The learner process: receives rollout chunks over LCM, gathers them into batches, runs one PPO
+// update per batch and broadcasts the new parameters.
+//
+// Chunks take the raw path (RolloutAssembler::acceptEncoded) because lcm-gen's decoder trusts
+// hostile length fields. Nothing waits for a particular actor or chunk: the collector hands out a
+// batch as soon as enough environments from whoever is alive have arrived, and the parameters are
+// re-published periodically so that a lost broadcast never stalls the actors.
+//
+// Run directory: config.yaml (resolved config), metrics.csv (one row per update), checkpoint.bin
+// (written atomically: tmp + rename).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/config/run_config.hpp"
+#include "common/model/actor_critic.hpp"
+#include "common/nn/adam.hpp"
+#include "common/transport/batch_collector.hpp"
+#include "common/transport/rollout_assembler.hpp"
+#include "common/transport/transport.hpp"
+#include "learner/ppo/ppo_trainer.hpp"
+#include "learner/ppo/rollout_buffer.hpp"
+
+namespace masa::learner {
+
+struct LearnerOptions {
+  std::string url;            // LCM provider URL ("" = LCM's default)
+  std::string run_dir;        // created if missing
+  int64_t run_id = 0;         // 0: random from the clock, or the checkpoint's when resuming
+  bool resume = false;        // load <run_dir>/checkpoint.bin and append to metrics.csv
+  int checkpoint_every = 10;  // updates between checkpoints (0: only on exit / explicit calls)
+  double republish_interval_s = 1.0;
+  bool verbose = true;  // one progress line per update on stdout
+};
+
+// Summary of the last update (also what the stats message carries).
+struct UpdateReport {
+  int64_t epoch = 0, version = 0, env_steps = 0;
+  double wall_time_s = 0, fps = 0;
+  int num_episodes = 0;
+  double mean_return = 0, mean_length = 0, success_rate = -1;
+  std::vector<double> term_means;
+  ppo::PpoStats ppo;
+  int64_t dropped = 0;
+};
+
+class Learner {
+ public:
+  Learner(const config::RunConfig& rc, const LearnerOptions& options);
+  ~Learner();
+  Learner(const Learner&) = delete;
+  Learner& operator=(const Learner&) = delete;
+
+  // One turn of the loop: waits up to timeout_ms for LCM traffic, handles everything queued, runs
+  // one update if a full batch is there, and re-publishes the parameters when due. Returns true
+  // when an update ran.
+  bool step(int timeout_ms);
+  // step() until `max_updates` updates have run in total (counting resumed ones) or *stop is set;
+  // then checkpoints.
+  void run(int64_t max_updates, const std::atomic<bool>* stop);
+
+  void writeCheckpoint();
+  void publishParams();
+
+  transport::Transport& transport() { return *transport_; }
+  int64_t runId() const { return run_id_; }
+  int64_t version() const { return version_; }
+  int64_t epoch() const { return epoch_; }
+  int64_t envSteps() const { return env_steps_; }
+  const std::string& runDir() const { return dir_; }
+  const model::ActorCritic<float>& model() const { return *model_; }
+  const transport::DropStats& dropStats() const { return assembler_->stats(); }
+  // Chunks dropped by the assembler plus environments dropped by the collector.
+  int64_t droppedTotal() const;
+  const UpdateReport& lastReport() const { return report_; }
+
+ private:
+  void onChunk(const void* data, int size);
+  void update(const transport::RolloutBatch& batch);
+  void fillBuffer(const transport::ActorRollout& d);
+  void summarizeEpisodes(const transport::ActorRollout& d);
+  void publishStats();
+  void appendCsv();
+  void loadCheckpoint();
+  double wallTime() const;
+
+  config::RunConfig rc_;
+  LearnerOptions opt_;
+  std::string dir_;
+  int64_t run_id_ = 0;
+
+  Rng rng_;
+  std::unique_ptr<model::ActorCritic<float>> model_;
+  std::unique_ptr<nn::Adam<float>> adam_;
+  std::unique_ptr<ppo::PpoTrainer> trainer_;
+  std::unique_ptr<ppo::RolloutBuffer> buffer_;
+
+  std::unique_ptr<transport::Transport> transport_;
+  std::unique_ptr<transport::RolloutAssembler> assembler_;  // made once the run id is known
+  // Made on the first accepted chunk: the reward term names come from the actors' task.
+  std::unique_ptr<transport::BatchCollector> collector_;
+  transport::RolloutBatch batch_;
+
+  int64_t version_ = 0, epoch_ = 0, env_steps_ = 0;
+  double wall_offset_s_ = 0;  // wall time of the runs before a resume
+  std::chrono::steady_clock::time_point start_, last_update_, last_publish_;
+  std::vector<int> restored_order_;  // shuffle permutation from a checkpoint, used once
+  UpdateReport report_;
+};
+
+}  // namespace masa::learner

@@ -1,0 +1,83 @@
+// masa_learner: the training process. Actors (masa_actor) send rollouts; this runs PPO and
+// broadcasts parameters.
+//   masa_learner --set task=trifinger_lift --set method=masa
+//   masa_learner --resume runs/trifinger_lift_masa_0_20260101-120000
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <ctime>
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "common/config/run_config.hpp"
+#include "common/model/method.hpp"
+#include "learner/learner.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
+
+void onSignal(int) { g_stop.store(true); }
+
+std::string timestamp() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  localtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof(buf), "%Y%m%d-%H%M%S", &tm);
+  return buf;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"masa learner: multi-agent PPO fed by actors over LCM"};
+  std::vector<std::string> overrides;
+  std::string configs = masa::config::defaultConfigsDir();
+  std::string run_dir, resume_dir, url;
+  int64_t run_id = 0;
+  int64_t max_updates = -1;
+  int checkpoint_every = 10;
+  app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set ppo.horizon=8");
+  app.add_option("--configs", configs, "configs directory (defaults.yaml, tasks/, specs/)");
+  app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_<timestamp>)");
+  app.add_option("--resume", resume_dir, "continue the run in this directory from its checkpoint.bin");
+  app.add_option("--url", url, "LCM provider URL (default: LCM_DEFAULT_URL or LCM's default)");
+  app.add_option("--run-id", run_id, "run id actors must carry (default: random, or the checkpoint's)");
+  app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_epochs)");
+  app.add_option("--checkpoint-every", checkpoint_every, "updates between checkpoints (0: only on exit)");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    const auto rc = masa::config::loadRunConfig(configs, overrides);
+    masa::learner::LearnerOptions opt;
+    opt.url = url;
+    opt.run_id = run_id;
+    opt.checkpoint_every = checkpoint_every;
+    if (!resume_dir.empty()) {
+      opt.resume = true;
+      opt.run_dir = resume_dir;
+    } else {
+      opt.run_dir = !run_dir.empty() ? run_dir
+                                     : "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" +
+                                           std::to_string(rc.seed) + "_" + timestamp();
+    }
+    if (max_updates < 0) max_updates = rc.ppo.max_epochs;
+
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    masa::learner::Learner learner(rc, opt);
+    std::cout << "masa_learner: run id " << learner.runId() << ", run dir " << learner.runDir() << ", version "
+              << learner.version() << ", url '" << url << "'" << std::endl;
+    // run() finishes the step in progress when a signal arrives, then checkpoints.
+    learner.run(max_updates, &g_stop);
+    std::cout << "masa_learner: stopped after " << learner.epoch() << " updates; checkpoint written" << std::endl;
+  } catch (const std::exception& e) {
+    std::cerr << "masa_learner: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,237 @@
+// The learner process over an in-process memq:// transport, fed by a fake actor: synthetic but
+// valid rollouts of the TriFinger spec's dimensions, chunked as a real actor chunks them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "common/config/run_config.hpp"
+#include "common/symmetry/symmetry_spec.hpp"
+#include "common/transport/channels.hpp"
+#include "common/transport/rollout_chunker.hpp"
+#include "learner/learner.hpp"
+#include "masa/lcmt_learner_stats.hpp"
+#include "masa/lcmt_policy_params.hpp"
+
+namespace masa::learner {
+namespace {
+
+namespace fs = std::filesystem;
+
+config::RunConfig smallConfig() {
+  return config::loadRunConfig(config::defaultConfigsDir(),
+                               {"task=trifinger_lift", "model.policy_hidden=[16]", "model.critic_hidden=[16]",
+                                "ppo.num_envs=8", "ppo.horizon=4", "ppo.minibatch_size=16", "ppo.mini_epochs=1"});
+}
+
+fs::path freshDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("masa_test_learner_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+LearnerOptions options(const fs::path& dir, int64_t run_id) {
+  LearnerOptions o;
+  o.url = "memq://";
+  o.run_dir = dir.string();
+  o.run_id = run_id;
+  o.verbose = false;
+  return o;
+}
+
+// A fake actor: a consistent Gaussian policy (mean 0, log std 0) with one time-out and one episode.
+struct FakeActor {
+  transport::ActorRollout rollout;
+  transport::RolloutChunker chunker;
+
+  FakeActor(const config::RunConfig& rc, uint64_t seed) {
+    const auto spec = sym::SymmetrySpec::load(rc.spec_path);
+    const int E = rc.ppo.num_envs, T = rc.ppo.horizon, od = spec.obsDim(), ad = spec.actDim();
+    rollout.allocate(E, T, od, ad, {"keypoints", "reach"});
+    rollout.clearEvents();
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<float> normal;
+    for (float& x : rollout.obs) x = normal(rng);
+    for (float& x : rollout.reward) x = normal(rng);
+    for (float& x : rollout.mean) x = 0.0f;
+    for (float& x : rollout.log_std) x = 0.0f;
+    for (int t = 0; t < T; ++t) {
+      for (int e = 0; e < E; ++e) {
+        double lp = 0;
+        float* a = rollout.actionAt(t, e);
+        for (int k = 0; k < ad; ++k) {
+          a[k] = normal(rng);
+          lp += -0.5 * a[k] * a[k] - 0.5 * std::log(2 * M_PI);
+        }
+        rollout.log_prob[rollout.step(t, e)] = static_cast<float>(lp);
+      }
+    }
+    std::vector<float> final_obs(od, 0.5f);
+    rollout.truncated[rollout.step(1, 2)] = 1;
+    rollout.addFinal(1, 2, final_obs.data());
+    const float terms[2] = {1.5f, -0.5f};
+    rollout.addEpisode(2, 3.0f, 20, 1, terms);
+  }
+
+  // Publishes the rollout's chunks as actor 0's rollout `seq`, acted with `version`.
+  int send(transport::Transport& t, int64_t run_id, int64_t seq, int64_t version) {
+    const auto chunks = chunker.split(rollout, {run_id, 0, seq, version});
+    for (const auto& c : chunks) t.publish(transport::kRolloutChannel, c);
+    return static_cast<int>(chunks.size());
+  }
+};
+
+// Steps until an update runs (or gives up), then lets the published messages reach subscribers.
+bool stepUntilUpdate(Learner& l, int max_steps = 200) {
+  bool updated = false;
+  for (int i = 0; i < max_steps && !updated; ++i) updated = l.step(0);
+  for (int i = 0; i < 5; ++i) l.step(0);
+  return updated;
+}
+
+std::vector<std::string> readLines(const fs::path& p) {
+  std::ifstream f(p);
+  std::vector<std::string> lines;
+  for (std::string s; std::getline(f, s);) lines.push_back(s);
+  return lines;
+}
+
+TEST(LearnerNode, OneBatchFromAFakeActorMakesVersionOneAndPublishesParamsStatsAndMetrics) {
+  const auto rc = smallConfig();
+  const fs::path dir = freshDir("update");
+  Learner learner(rc, options(dir, 77));
+  masa::lcmt_policy_params params;
+  masa::lcmt_learner_stats stats;
+  int num_stats = 0;
+  learner.transport().subscribe<masa::lcmt_policy_params>(transport::kPolicyChannel,
+                                                          [&](const masa::lcmt_policy_params& m) { params = m; });
+  learner.transport().subscribe<masa::lcmt_learner_stats>(transport::kLearnerStatsChannel,
+                                                          [&](const masa::lcmt_learner_stats& m) {
+                                                            stats = m;
+                                                            ++num_stats;
+                                                          });
+  FakeActor actor(rc, 1);
+  actor.send(learner.transport(), 77, 0, 0);
+  ASSERT_TRUE(stepUntilUpdate(learner));
+
+  EXPECT_EQ(learner.version(), 1);
+  EXPECT_EQ(learner.epoch(), 1);
+  EXPECT_EQ(learner.envSteps(), 8 * 4);
+  EXPECT_EQ(params.version, 1);
+  EXPECT_EQ(params.run_id, 77);
+  EXPECT_EQ(params.task, "trifinger_lift");
+  const auto& p = learner.model().params().values();
+  ASSERT_EQ(params.num_params, p.size());
+  EXPECT_EQ(std::memcmp(params.params.data(), p.data(), p.size() * sizeof(float)), 0);
+  EXPECT_EQ(params.obs_dim, learner.model().obsDim());
+  for (float s : params.obs_std) EXPECT_GT(s, 0.0f);
+
+  ASSERT_EQ(num_stats, 1);
+  EXPECT_EQ(stats.version, 1);
+  EXPECT_EQ(stats.epoch, 0);
+  EXPECT_EQ(stats.env_steps, 32);
+  EXPECT_EQ(stats.num_episodes, 1);
+  EXPECT_FLOAT_EQ(stats.mean_episode_return, 3.0f);
+  EXPECT_FLOAT_EQ(stats.success_rate, 1.0f);
+  ASSERT_EQ(stats.num_terms, 2);
+  EXPECT_EQ(stats.term_names[0], "keypoints");
+  EXPECT_FLOAT_EQ(stats.term_means[1], -0.5f);
+  EXPECT_TRUE(std::isfinite(stats.actor_loss) && std::isfinite(stats.critic_loss));
+  EXPECT_GT(stats.learning_rate, 0.0f);
+
+  const auto lines = readLines(dir / "metrics.csv");
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0].rfind("epoch,version,env_steps,wall_time_s,fps,return,length,success,term_keypoints", 0), 0u);
+  EXPECT_EQ(lines[1].rfind("0,1,32,", 0), 0u);
+  EXPECT_TRUE(fs::exists(dir / "config.yaml"));
+  fs::remove_all(dir);
+}
+
+TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTriggerAnUpdate) {
+  const auto rc = smallConfig();
+  const fs::path dir = freshDir("drops");
+  Learner learner(rc, options(dir, 5));
+  masa::lcmt_learner_stats stats;
+  learner.transport().subscribe<masa::lcmt_learner_stats>(
+      transport::kLearnerStatsChannel, [&](const masa::lcmt_learner_stats& m) { stats = m; });
+  FakeActor actor(rc, 2);
+  // A full batch of another run.
+  const int foreign = actor.send(learner.transport(), 6, 0, 0);
+  // Garbage bytes, and a whole batch of this run poisoned with a NaN in every chunk.
+  const char junk[] = "definitely not an lcmt_rollout_chunk";
+  learner.transport().publishRaw(transport::kRolloutChannel, junk, sizeof(junk));
+  FakeActor poisoned(rc, 3);
+  for (float& x : poisoned.rollout.reward) x = std::nanf("");
+  const int nan_chunks = poisoned.send(learner.transport(), 5, 0, 0);
+  EXPECT_FALSE(stepUntilUpdate(learner, 50));
+  EXPECT_EQ(learner.version(), 0);
+  EXPECT_EQ(learner.dropStats()[transport::DropReason::kWrongRun], foreign);
+  EXPECT_EQ(learner.dropStats()[transport::DropReason::kMalformed], 1);
+  EXPECT_EQ(learner.dropStats()[transport::DropReason::kNonFinite], nan_chunks);
+  EXPECT_FALSE(fs::exists(dir / "metrics.csv"));
+
+  // The next good batch goes through, and its stats carry the drops.
+  actor.send(learner.transport(), 5, 1, 0);
+  ASSERT_TRUE(stepUntilUpdate(learner));
+  ASSERT_EQ(stats.version, 1);
+  auto countOf = [&](const std::string& name) {
+    for (int i = 0; i < stats.num_drop_reasons; ++i)
+      if (stats.drop_reason_names[i] == name) return stats.drop_counts[i];
+    return int64_t{-1};
+  };
+  EXPECT_EQ(countOf("wrong_run"), foreign);
+  EXPECT_EQ(countOf("malformed"), 1);
+  EXPECT_EQ(countOf("non_finite"), nan_chunks);
+  EXPECT_EQ(learner.droppedTotal(), foreign + 1 + nan_chunks);
+  fs::remove_all(dir);
+}
+
+TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv) {
+  const auto rc = smallConfig();
+  const fs::path dir_a = freshDir("ckpt_a"), dir_b = freshDir("ckpt_b");
+  FakeActor first(rc, 10), second(rc, 11);
+  std::vector<float> params_a;
+  {
+    LearnerOptions o = options(dir_a, 9);
+    o.checkpoint_every = 1;
+    Learner a(rc, o);
+    first.send(a.transport(), 9, 0, 0);
+    ASSERT_TRUE(stepUntilUpdate(a));
+    ASSERT_TRUE(fs::exists(dir_a / "checkpoint.bin"));
+    fs::copy(dir_a, dir_b, fs::copy_options::recursive);  // the run as it was after update 1
+    second.send(a.transport(), 9, 1, 1);
+    ASSERT_TRUE(stepUntilUpdate(a));
+    ASSERT_EQ(a.version(), 2);
+    const auto& p = a.model().params().values();
+    params_a.assign(p.data(), p.data() + p.size());
+  }
+  LearnerOptions o = options(dir_b, 0);  // run id from the checkpoint
+  o.resume = true;
+  Learner b(rc, o);
+  EXPECT_EQ(b.runId(), 9);
+  EXPECT_EQ(b.version(), 1);
+  EXPECT_EQ(b.envSteps(), 32);
+  second.send(b.transport(), 9, 1, 1);
+  ASSERT_TRUE(stepUntilUpdate(b));
+  EXPECT_EQ(b.version(), 2);
+  const auto& p = b.model().params().values();
+  ASSERT_EQ(static_cast<std::size_t>(p.size()), params_a.size());
+  EXPECT_EQ(std::memcmp(p.data(), params_a.data(), params_a.size() * sizeof(float)), 0);
+
+  const auto lines = readLines(dir_b / "metrics.csv");
+  ASSERT_EQ(lines.size(), 3u);  // one header, the row before the checkpoint, the resumed row
+  EXPECT_EQ(lines[0].rfind("epoch,", 0), 0u);
+  EXPECT_EQ(lines[2].rfind("1,2,64,", 0), 0u);
+  fs::remove_all(dir_a);
+  fs::remove_all(dir_b);
+}
+
+}  // namespace
+}  // namespace masa::learner
