@@ -1,0 +1,268 @@
+#include "actors/actor.hpp"
+
+#include <omp.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "common/model/diag_gaussian.hpp"
+#include "common/symmetry/symmetry_spec.hpp"
+#include "common/transport/channels.hpp"
+#include "masa/lcmt_actor_heartbeat.hpp"
+
+namespace masa::actor {
+namespace {
+
+double nowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+Rng envRng(std::uint64_t seed, int actor_id, int env) {
+  // seed_seq mixes all three, so neighbouring (actor, env) pairs get unrelated streams.
+  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                    static_cast<std::uint32_t>(actor_id), static_cast<std::uint32_t>(env), 0x6d617361u};
+  return Rng(seq);
+}
+
+// Runs f with the calling thread's OpenMP team size at 1, so the network's GEMM stays serial.
+template <class F>
+void singleThreaded(F&& f) {
+  const int prev = omp_get_max_threads();
+  omp_set_num_threads(1);
+  f();
+  omp_set_num_threads(prev);
+}
+
+}  // namespace
+
+Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::Transport* transport)
+    : config_(config),
+      options_(std::move(options)),
+      num_envs_(options_.num_envs),
+      horizon_(config.ppo.horizon),
+      transport_(transport),
+      chunker_(options_.chunk_bytes) {
+  if (num_envs_ <= 0) throw std::runtime_error("actor: num_envs must be positive, got " + std::to_string(num_envs_));
+  if (horizon_ <= 0) throw std::runtime_error("actor: ppo.horizon must be positive, got " + std::to_string(horizon_));
+  if (options_.actor_id < 0) throw std::runtime_error("actor: actor_id must be >= 0");
+  if (options_.threads <= 0) throw std::runtime_error("actor: threads must be positive");
+
+  const auto spec = sym::SymmetrySpec::load(config_.spec_path);
+  factory_ = std::make_unique<task::TaskFactory>(config_.task, spec, config_.env, config_.origin);
+  envs_.reserve(num_envs_);
+  rngs_.reserve(num_envs_);
+  for (int e = 0; e < num_envs_; ++e) {
+    envs_.push_back(factory_->create());
+    rngs_.push_back(envRng(config_.seed, options_.actor_id, e));
+  }
+  obs_dim_ = envs_[0]->obsDim();
+  act_dim_ = envs_[0]->actDim();
+  const auto& terms = envs_[0]->rewardTermNames();
+  num_terms_ = static_cast<int>(terms.size());
+
+  model_ = std::make_unique<model::ActorCritic<float>>(spec, config_.model);
+  policy_param_count_ = model_->params().size();
+  for (const auto& seg : model_->params().segments())
+    if (seg.name.rfind("critic", 0) == 0) {
+      policy_param_count_ = seg.offset;
+      break;
+    }
+  {
+    // Own initial parameters: used only with start_without_learner, and deterministic per seed.
+    Rng init_rng = envRng(config_.seed, options_.actor_id, -1);
+    model_->initialize(init_rng);
+  }
+  if (options_.start_without_learner) version_ = 0;
+
+  rollout_.allocate(num_envs_, horizon_, obs_dim_, act_dim_, terms);
+  done_.assign(num_envs_, 0);
+  final_obs_.assign(static_cast<std::size_t>(num_envs_) * obs_dim_, 0.0f);
+  ep_return_.assign(num_envs_, 0.0f);
+  ep_length_.assign(num_envs_, 0);
+  ep_success_.assign(num_envs_, -1);
+  ep_terms_.assign(static_cast<std::size_t>(num_envs_) * std::max(num_terms_, 1), 0.0f);
+  log_std_.resize(act_dim_);
+  pending_params_.resize(model_->params().size());
+  pending_mean_.resize(obs_dim_);
+  pending_std_.resize(obs_dim_);
+
+  for (int e = 0; e < num_envs_; ++e) envs_[e]->reset(rngs_[e]);
+
+  if (!transport_) {
+    owned_transport_ =
+        std::make_unique<transport::Transport>(options_.url.empty() ? transport::loopbackUrl() : options_.url);
+    transport_ = owned_transport_.get();
+  }
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) == 0) hostname_ = host;
+  transport_->subscribe<masa::lcmt_policy_params>(
+      transport::kPolicyChannel, [this](const masa::lcmt_policy_params& m) { onParams(m); });
+}
+
+Actor::~Actor() = default;
+
+void Actor::onParams(const masa::lcmt_policy_params& m) {
+  if (m.run_id != options_.run_id) return;  // another run on the same network
+  const int64_t newest = std::max(version_, pending_version_);
+  if (m.version <= newest) return;  // the learner repeats its latest parameters periodically
+  if (m.version <= last_rejected_version_) return;  // warned already: the learner repeats it
+  auto reject = [&](const std::string& why) {
+    ++params_rejected_;
+    last_rejected_version_ = m.version;
+    std::fprintf(stderr, "masa_actor %d: ignoring parameters version %lld: %s\n", options_.actor_id,
+                 static_cast<long long>(m.version), why.c_str());
+  };
+  if (m.task != config_.task) return reject("task '" + m.task + "', this actor runs '" + config_.task + "'");
+  if (m.method != model::methodName(config_.method))
+    return reject("method '" + m.method + "', this actor builds '" + model::methodName(config_.method) + "'");
+  const int n = m.num_params;
+  if (n != model_->params().size() && n != policy_param_count_)
+    return reject("num_params " + std::to_string(n) + ", expected " + std::to_string(policy_param_count_) +
+                  " (policy) or " + std::to_string(model_->params().size()) + " (whole model)");
+  if (static_cast<int>(m.params.size()) != n) return reject("params array length differs from num_params");
+  // obs_dim 0: the learner does not normalize; the actor's normalizer stays at identity.
+  if (m.obs_dim != 0 && m.obs_dim != obs_dim_)
+    return reject("obs_dim " + std::to_string(m.obs_dim) + ", expected " + std::to_string(obs_dim_));
+  if (static_cast<int>(m.obs_mean.size()) != m.obs_dim || static_cast<int>(m.obs_std.size()) != m.obs_dim)
+    return reject("normalizer arrays differ from obs_dim");
+  for (float v : m.params)
+    if (!std::isfinite(v)) return reject("non-finite parameter");
+  for (int d = 0; d < m.obs_dim; ++d)
+    if (!std::isfinite(m.obs_mean[d]) || !std::isfinite(m.obs_std[d]) || !(m.obs_std[d] > 0.0f))
+      return reject("bad normalizer entry " + std::to_string(d));
+  std::copy(m.params.begin(), m.params.end(), pending_params_.begin());
+  pending_count_ = n;
+  if (m.obs_dim > 0) {
+    std::copy(m.obs_mean.begin(), m.obs_mean.end(), pending_mean_.begin());
+    std::copy(m.obs_std.begin(), m.obs_std.end(), pending_std_.begin());
+  }
+  pending_version_ = m.version;
+  pending_has_norm_ = m.obs_dim > 0;
+}
+
+void Actor::swapInPending() {
+  if (pending_version_ < 0) return;
+  auto& values = model_->params().values();
+  std::copy(pending_params_.begin(), pending_params_.begin() + pending_count_, values.data());
+  if (pending_has_norm_) model_->obsNormalizer().setMeanStd(pending_mean_.data(), pending_std_.data());
+  version_ = pending_version_;
+  pending_version_ = -1;
+}
+
+bool Actor::pollParams(int timeout_ms) {
+  if (!hasParams() && pending_version_ < 0) transport_->handleTimeout(timeout_ms);
+  transport_->drain();
+  if (!hasParams()) swapInPending();
+  maybeHeartbeat();
+  return hasParams();
+}
+
+void Actor::publishHeartbeat() {
+  const double now = nowSeconds();
+  masa::lcmt_actor_heartbeat hb;
+  hb.run_id = options_.run_id;
+  hb.actor_id = options_.actor_id;
+  hb.utime = transport::wallClockMicros();
+  hb.hostname = hostname_;
+  hb.num_envs = num_envs_;
+  const double dt = now - last_heartbeat_s_;
+  hb.steps_per_second = (dt > 0.0 && dt < 1e9) ? static_cast<float>(steps_since_heartbeat_ / dt) : 0.0f;
+  hb.policy_version = version_;
+  hb.rollouts_sent = rollouts_sent_;
+  transport_->publish(transport::kHeartbeatChannel, hb);
+  last_heartbeat_s_ = now;
+  steps_since_heartbeat_ = 0;
+}
+
+void Actor::maybeHeartbeat() {
+  if (nowSeconds() - last_heartbeat_s_ >= options_.heartbeat_interval_s) publishHeartbeat();
+}
+
+bool Actor::collectAndPublish() {
+  swapInPending();  // the only place parameters change
+  if (!hasParams()) throw std::logic_error("actor: collectAndPublish before any parameters");
+  const int64_t acting_version = version_;
+  const int E = num_envs_;
+  rollout_.clearEvents();
+  model_->logStd(log_std_);
+  std::copy(log_std_.data(), log_std_.data() + act_dim_, rollout_.log_std.begin());
+
+  for (int e = 0; e < E; ++e) envs_[e]->observe(rollout_.obsAt(0, e));
+  const int threads = std::min(options_.threads, E);
+  for (int t = 0; t < horizon_; ++t) {
+    // Step t's observations, actions and means are contiguous obs_dim x E / act_dim x E blocks.
+    Eigen::Map<const Mat<float>> obs(rollout_.obsAt(t, 0), obs_dim_, E);
+    singleThreaded([&] {
+      auto mean = model_->actMean(obs);
+      Eigen::Map<Mat<float>>(rollout_.meanAt(t, 0), act_dim_, E) = mean;
+    });
+    float* log_prob = rollout_.log_prob.data() + rollout_.step(t, 0);
+    float* reward = rollout_.reward.data() + rollout_.step(t, 0);
+    int8_t* term = rollout_.terminated.data() + rollout_.step(t, 0);
+    int8_t* trunc = rollout_.truncated.data() + rollout_.step(t, 0);
+
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (int e = 0; e < E; ++e) {
+      Eigen::Map<const Mat<float>> mu(rollout_.meanAt(t, e), act_dim_, 1);
+      Eigen::Map<Mat<float>> act(rollout_.actionAt(t, e), act_dim_, 1);
+      Eigen::Map<Mat<float>> lp(log_prob + e, 1, 1);
+      model::gaussian::sample<float>(mu, log_std_, rngs_[e], act);
+      model::gaussian::logProb<float>(mu, log_std_, act, lp);
+      auto& env = *envs_[e];
+      const task::StepOutcome out = env.step(rollout_.actionAt(t, e));
+      reward[e] = static_cast<float>(out.reward);
+      term[e] = out.terminated ? 1 : 0;
+      trunc[e] = out.truncated ? 1 : 0;
+      const bool done = out.terminated || out.truncated;
+      done_[e] = done ? 1 : 0;
+      if (done) {
+        if (out.truncated) env.observe(final_obs_.data() + static_cast<std::size_t>(e) * obs_dim_);
+        const auto& st = env.episode();
+        ep_return_[e] = static_cast<float>(st.ret);
+        ep_length_[e] = st.length;
+        ep_success_[e] = st.has_success ? (st.success ? 1 : 0) : -1;
+        for (int k = 0; k < num_terms_; ++k)
+          ep_terms_[static_cast<std::size_t>(e) * num_terms_ + k] = static_cast<float>(st.term_sums[k]);
+        env.reset(rngs_[e]);
+      }
+      env.observe(rollout_.obsAt(t + 1, e));
+    }
+    // Events in ascending (t, e) order, as ActorRollout requires.
+    for (int e = 0; e < E; ++e) {
+      if (!done_[e]) continue;
+      if (trunc[e]) rollout_.addFinal(t, e, final_obs_.data() + static_cast<std::size_t>(e) * obs_dim_);
+      rollout_.addEpisode(e, ep_return_[e], ep_length_[e], ep_success_[e],
+                          num_terms_ ? ep_terms_.data() + static_cast<std::size_t>(e) * num_terms_ : nullptr);
+    }
+    steps_since_heartbeat_ += E;
+    if (options_.after_step) options_.after_step(rollouts_sent_, t);
+    transport_->drain();  // parameters go to the pending buffer; nothing changes mid-rollout
+    maybeHeartbeat();
+    if (stopRequested()) return false;
+  }
+
+  transport::RolloutIdentity id;
+  id.run_id = options_.run_id;
+  id.actor_id = options_.actor_id;
+  id.rollout_seq = rollouts_sent_;
+  id.policy_version = acting_version;
+  for (const auto& chunk : chunker_.split(rollout_, id)) transport_->publish(transport::kRolloutChannel, chunk);
+  ++rollouts_sent_;
+  return true;
+}
+
+int64_t Actor::run() {
+  publishHeartbeat();  // announce at start, before any parameters
+  while (!stopRequested() && !pollParams(100)) {
+  }
+  while (!stopRequested() && (options_.max_rollouts < 0 || rollouts_sent_ < options_.max_rollouts)) {
+    if (!collectAndPublish()) break;
+  }
+  publishHeartbeat();  // final state: version acted with, rollouts sent
+  return rollouts_sent_;
+}
+
+}  // namespace masa::actor

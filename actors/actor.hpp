@@ -1,0 +1,119 @@
+// An actor process's worker: E task instances stepped together, acting with the newest policy
+// received from the learner, and streaming each T-step rollout as LCM chunks.
+//
+// Determinism: environment e of actor a draws resets and action noise from its own Rng, seeded
+// from (run seed, a, e), so a run is reproducible for any thread count. Parameters received while
+// a rollout is being collected wait in a pending buffer and are swapped in only between rollouts,
+// so every chunk of a rollout was produced by the one version it names.
+//
+// Threading: the network runs single-threaded (its 2-thread GEMM collapses when cores are
+// shared by several actors); OpenMP is used only over environments.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/config/run_config.hpp"
+#include "common/model/actor_critic.hpp"
+#include "common/task/registry.hpp"
+#include "common/transport/actor_rollout.hpp"
+#include "common/transport/rollout_chunker.hpp"
+#include "common/transport/transport.hpp"
+#include "masa/lcmt_policy_params.hpp"
+
+namespace masa::actor {
+
+struct ActorOptions {
+  int actor_id = 0;
+  int num_envs = 1;
+  int64_t run_id = 0;
+  std::string url;               // "" -> transport::loopbackUrl(); ignored with an external transport
+  int64_t max_rollouts = -1;     // < 0: until stopped
+  int threads = 1;               // OpenMP threads over environments
+  bool start_without_learner = false;  // act with own initial parameters as version 0
+  double heartbeat_interval_s = 1.0;
+  int chunk_bytes = transport::kDefaultChunkBytes;
+  const std::atomic<bool>* stop = nullptr;  // checked between steps (signal handlers set it)
+  // Test hook: called after each step t of a rollout, before incoming messages are handled.
+  std::function<void(int64_t rollout_seq, int t)> after_step;
+};
+
+class Actor {
+ public:
+  // Throws std::runtime_error / ConfigError on a bad configuration. With `transport` given (memq
+  // tests share one in-process LCM), it is used instead of opening options.url; it must outlive
+  // the actor.
+  Actor(const config::RunConfig& config, ActorOptions options, transport::Transport* transport = nullptr);
+  ~Actor();
+  Actor(const Actor&) = delete;
+  Actor& operator=(const Actor&) = delete;
+
+  // Waits for parameters (unless start_without_learner), then collects and publishes rollouts
+  // until stopped or max_rollouts. Returns the number of rollouts sent.
+  int64_t run();
+
+  // One rollout: swaps in pending parameters, collects T steps, publishes. Requires parameters.
+  // Returns false when stopped midway (nothing published).
+  bool collectAndPublish();
+  // Handles incoming messages for up to timeout_ms; true once parameters are available.
+  bool pollParams(int timeout_ms);
+
+  bool hasParams() const { return version_ >= 0; }
+  int64_t policyVersion() const { return version_; }
+  int64_t rolloutsSent() const { return rollouts_sent_; }
+  int64_t paramsRejected() const { return params_rejected_; }
+  const transport::ActorRollout& lastRollout() const { return rollout_; }
+  int numEnvs() const { return num_envs_; }
+  model::ActorCritic<float>& model() { return *model_; }
+  void publishHeartbeat();
+
+ private:
+  void onParams(const masa::lcmt_policy_params& msg);
+  void swapInPending();
+  bool stopRequested() const { return options_.stop && options_.stop->load(std::memory_order_relaxed); }
+  void maybeHeartbeat();
+
+  config::RunConfig config_;
+  ActorOptions options_;
+  int num_envs_;
+  int horizon_;
+  std::unique_ptr<transport::Transport> owned_transport_;
+  transport::Transport* transport_;
+  std::unique_ptr<task::TaskFactory> factory_;
+  std::vector<std::unique_ptr<task::Task>> envs_;
+  std::vector<Rng> rngs_;
+  std::unique_ptr<model::ActorCritic<float>> model_;
+  int policy_param_count_ = 0;  // the policy + log-std prefix of the flat parameters
+  transport::ActorRollout rollout_;
+  transport::RolloutChunker chunker_;
+  int obs_dim_, act_dim_, num_terms_;
+
+  // Per-environment scratch of one step, filled in parallel and recorded in env order after it.
+  std::vector<int8_t> done_;
+  std::vector<float> final_obs_;
+  std::vector<float> ep_return_;
+  std::vector<int32_t> ep_length_;
+  std::vector<int8_t> ep_success_;
+  std::vector<float> ep_terms_;
+  Eigen::VectorXf log_std_;
+
+  // Parameters received but not yet in use (version -1: none).
+  int64_t version_ = -1;
+  int64_t pending_version_ = -1;
+  std::vector<float> pending_params_, pending_mean_, pending_std_;
+  int pending_count_ = 0;
+  bool pending_has_norm_ = false;
+  int64_t params_rejected_ = 0;
+  int64_t last_rejected_version_ = -1;
+
+  int64_t rollouts_sent_ = 0;
+  std::string hostname_;
+  double last_heartbeat_s_ = -1e300;
+  int64_t steps_since_heartbeat_ = 0;
+};
+
+}  // namespace masa::actor

@@ -1,0 +1,287 @@
+// The actor over memq:// (one in-process LCM shared with a fake learner): parameters in, rollout
+// chunks and heartbeats out.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "actors/actor.hpp"
+#include "common/config/run_config.hpp"
+#include "common/symmetry/symmetry_spec.hpp"
+#include "common/transport/channels.hpp"
+#include "common/transport/rollout_assembler.hpp"
+#include "common/transport/transport.hpp"
+#include "masa/lcmt_actor_heartbeat.hpp"
+#include "masa/lcmt_policy_params.hpp"
+#include "masa/lcmt_rollout_chunk.hpp"
+
+namespace masa {
+namespace {
+
+constexpr int64_t kRunId = 777;
+constexpr int kHorizon = 8;
+constexpr int kEpisodeSteps = 5;  // shorter than the horizon: every env finishes an episode
+
+config::RunConfig smallConfig(uint64_t seed, const std::string& task = "trifinger_lift") {
+  return config::loadRunConfig(std::string(MASA_SOURCE_DIR) + "/configs",
+                               {"task=" + task, "seed=" + std::to_string(seed), "ppo.horizon=" + std::to_string(kHorizon),
+                                "model.policy_hidden=[16]", "model.critic_hidden=[16]",
+                                "env.max_episode_steps=" + std::to_string(kEpisodeSteps)});
+}
+
+// Plays the learner's side: its own initialized model, broadcast as the policy prefix.
+struct FakeLearner {
+  FakeLearner(const config::RunConfig& rc, uint64_t init_seed)
+      : spec(sym::SymmetrySpec::load(rc.spec_path)), model(spec, rc.model), rc(rc) {
+    Rng rng(init_seed);
+    model.initialize(rng);
+  }
+  masa::lcmt_policy_params message(int64_t version, float param_shift = 0.0f) const {
+    masa::lcmt_policy_params p;
+    p.run_id = kRunId;
+    p.utime = 0;
+    p.version = version;
+    p.method = model::methodName(rc.method);
+    p.task = rc.task;
+    int policy = model.params().size();
+    for (const auto& s : model.params().segments())
+      if (s.name.rfind("critic", 0) == 0) {
+        policy = s.offset;
+        break;
+      }
+    p.num_params = policy;
+    p.params.assign(model.params().values().data(), model.params().values().data() + policy);
+    for (auto& v : p.params) v += param_shift;
+    p.obs_dim = spec.obsDim();
+    p.obs_mean.assign(p.obs_dim, 0.1f);
+    p.obs_std.assign(p.obs_dim, 2.0f);
+    return p;
+  }
+  sym::SymmetrySpec spec;
+  model::ActorCritic<float> model;
+  config::RunConfig rc;
+};
+
+struct Capture {
+  explicit Capture(transport::Transport& t) {
+    t.subscribeRaw(transport::kRolloutChannel, [this](const void* d, int n) {
+      chunks.emplace_back(static_cast<const uint8_t*>(d), static_cast<const uint8_t*>(d) + n);
+    });
+    t.subscribe<masa::lcmt_actor_heartbeat>(transport::kHeartbeatChannel,
+                                            [this](const masa::lcmt_actor_heartbeat& h) { heartbeats.push_back(h); });
+  }
+  std::vector<std::vector<uint8_t>> chunks;
+  std::vector<masa::lcmt_actor_heartbeat> heartbeats;
+};
+
+masa::lcmt_rollout_chunk decode(const std::vector<uint8_t>& bytes) {
+  masa::lcmt_rollout_chunk c;
+  EXPECT_EQ(c.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  return c;
+}
+
+actor::ActorOptions options(int num_envs, int64_t max_rollouts) {
+  actor::ActorOptions o;
+  o.actor_id = 3;
+  o.num_envs = num_envs;
+  o.run_id = kRunId;
+  o.max_rollouts = max_rollouts;
+  o.threads = 2;
+  o.chunk_bytes = 8000;  // small, so that a rollout is split into several chunks
+  return o;
+}
+
+TEST(ActorRollouts, ChunksFromLearnerParamsPassTheAssemblerWithAllEnvsAndEpisodes) {
+  const auto rc = smallConfig(1);
+  transport::Transport bus("memq://");
+  Capture cap(bus);
+  FakeLearner learner(rc, 5);
+  const int E = 6;
+  actor::Actor actor(rc, options(E, 2), &bus);
+  ASSERT_TRUE(bus.publish(transport::kPolicyChannel, learner.message(1)));
+  EXPECT_EQ(actor.run(), 2);
+  bus.drain();
+  ASSERT_EQ(actor.paramsRejected(), 0);
+
+  transport::AssemblerConfig ac;
+  ac.run_id = kRunId;
+  ac.horizon = kHorizon;
+  ac.obs_dim = learner.spec.obsDim();
+  ac.act_dim = learner.spec.actDim();
+  ac.warn_interval_s = -1;
+  transport::RolloutAssembler assembler(ac);
+  assembler.setLearnerVersion(1);
+  ASSERT_GE(cap.chunks.size(), 4u) << "expected each rollout split into at least two chunks";
+  std::vector<std::set<int>> envs_seen(2);
+  int episodes = 0, finals = 0;
+  for (const auto& bytes : cap.chunks) {
+    const auto v = assembler.acceptEncoded(bytes.data(), static_cast<int>(bytes.size()));
+    ASSERT_TRUE(v) << "dropped: " << static_cast<int>(v.reason);
+    const auto& m = v.chunk->msg();
+    EXPECT_EQ(m.policy_version, 1);
+    EXPECT_EQ(m.actor_id, 3);
+    ASSERT_GE(m.rollout_seq, 0);
+    ASSERT_LT(m.rollout_seq, 2);
+    for (int e = 0; e < m.num_envs; ++e) EXPECT_TRUE(envs_seen[m.rollout_seq].insert(m.env_offset + e).second);
+    for (float x : m.obs) ASSERT_TRUE(std::isfinite(x));
+    for (float x : m.reward) ASSERT_TRUE(std::isfinite(x));
+    episodes += m.num_episodes;
+    finals += m.num_final;
+    for (int k = 0; k < m.num_episodes; ++k) {
+      EXPECT_EQ(m.episode_length[k], kEpisodeSteps);
+      EXPECT_TRUE(std::isfinite(m.episode_return[k]));
+    }
+    EXPECT_EQ(m.num_terms, static_cast<int>(m.term_names.size()));
+    EXPECT_GT(m.num_terms, 0);
+  }
+  EXPECT_EQ(assembler.stats().dropped(), 0);
+  for (const auto& s : envs_seen) EXPECT_EQ(static_cast<int>(s.size()), E);
+  // 2 rollouts of 8 steps with 5-step episodes: every env ends episodes at steps 5, 10 and 15
+  // (episodes run on across rollouts), all by the time limit.
+  EXPECT_EQ(episodes, 3 * E);
+  EXPECT_EQ(finals, 3 * E) << "time-limit ends carry their pre-reset observation";
+}
+
+TEST(ActorRollouts, ParametersPublishedMidRolloutApplyFromTheNextRollout) {
+  const auto rc = smallConfig(2);
+  transport::Transport bus("memq://");
+  Capture cap(bus);
+  FakeLearner learner(rc, 5);
+  auto opt = options(3, 2);
+  opt.after_step = [&](int64_t seq, int t) {
+    if (seq == 0 && t == 3) bus.publish(transport::kPolicyChannel, learner.message(2, 0.05f));
+  };
+  actor::Actor actor(rc, opt, &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(1));
+  ASSERT_TRUE(actor.pollParams(100));
+  ASSERT_EQ(actor.policyVersion(), 1);
+  ASSERT_TRUE(actor.collectAndPublish());
+  EXPECT_EQ(actor.policyVersion(), 1) << "version 2 arrived mid-rollout but must wait";
+  ASSERT_TRUE(actor.collectAndPublish());
+  EXPECT_EQ(actor.policyVersion(), 2);
+  bus.drain();
+  ASSERT_FALSE(cap.chunks.empty());
+  for (const auto& bytes : cap.chunks) {
+    const auto m = decode(bytes);
+    EXPECT_EQ(m.policy_version, m.rollout_seq == 0 ? 1 : 2) << "rollout " << m.rollout_seq;
+  }
+  // The swapped-in parameters and normalizer are the broadcast ones.
+  const auto msg = learner.message(2, 0.05f);
+  for (int i = 0; i < msg.num_params; ++i) ASSERT_EQ(actor.model().params().values()[i], msg.params[i]);
+  EXPECT_NEAR(actor.model().obsNormalizer().mean()[0], 0.1, 1e-6);
+}
+
+std::vector<std::vector<uint8_t>> runOnce(uint64_t seed, int threads) {
+  const auto rc = smallConfig(seed);
+  transport::Transport bus("memq://");
+  Capture cap(bus);
+  FakeLearner learner(rc, 5);
+  auto opt = options(4, 2);
+  opt.threads = threads;
+  actor::Actor actor(rc, opt, &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(1));
+  actor.run();
+  bus.drain();
+  return cap.chunks;
+}
+
+TEST(ActorRollouts, SameSeedGivesBitIdenticalChunksForAnyThreadCount) {
+  const auto a = runOnce(11, 1);
+  const auto b = runOnce(11, 1);
+  const auto c = runOnce(11, 3);
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a, c) << "per-env generators make the result independent of the thread count";
+}
+
+TEST(ActorRollouts, DifferentSeedGivesDifferentChunks) {
+  const auto a = runOnce(11, 2);
+  const auto b = runOnce(12, 2);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_NE(decode(a[0]).actions, decode(b[0]).actions);
+}
+
+TEST(ActorRollouts, HeartbeatNamesTheActorAndItsVersion) {
+  const auto rc = smallConfig(3, "a1_beam");
+  transport::Transport bus("memq://");
+  Capture cap(bus);
+  FakeLearner learner(rc, 5);
+  actor::Actor actor(rc, options(2, 1), &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(4));
+  actor.run();
+  bus.drain();
+  ASSERT_GE(cap.heartbeats.size(), 2u) << "one at start, one at stop";
+  EXPECT_EQ(cap.heartbeats.front().policy_version, -1) << "no parameters yet at start";
+  const auto& last = cap.heartbeats.back();
+  EXPECT_EQ(last.run_id, kRunId);
+  EXPECT_EQ(last.actor_id, 3);
+  EXPECT_EQ(last.num_envs, 2);
+  EXPECT_EQ(last.policy_version, 4);
+  EXPECT_EQ(last.rollouts_sent, 1);
+  EXPECT_GT(last.steps_per_second, 0.0f);
+}
+
+TEST(ActorRollouts, ParametersOfAnotherRunOrTaskAreIgnored) {
+  const auto rc = smallConfig(4);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  actor::Actor actor(rc, options(1, 1), &bus);
+  auto other_run = learner.message(1);
+  other_run.run_id = kRunId + 1;
+  bus.publish(transport::kPolicyChannel, other_run);
+  auto other_task = learner.message(1);
+  other_task.task = "a1_beam";
+  bus.publish(transport::kPolicyChannel, other_task);
+  EXPECT_FALSE(actor.pollParams(10));
+  EXPECT_FALSE(actor.hasParams());
+  EXPECT_EQ(actor.paramsRejected(), 1);
+}
+
+TEST(ActorRollouts, WholeModelParametersAreAcceptedAsWellAsThePolicyPrefix) {
+  const auto rc = smallConfig(4);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  actor::Actor actor(rc, options(1, 1), &bus);
+  auto whole = learner.message(1);
+  whole.num_params = learner.model.params().size();
+  whole.params.assign(learner.model.params().values().data(),
+                      learner.model.params().values().data() + whole.num_params);
+  bus.publish(transport::kPolicyChannel, whole);
+  ASSERT_TRUE(actor.pollParams(10));
+  EXPECT_EQ(actor.model().params().values(), learner.model.params().values());
+}
+
+TEST(ActorRollouts, StartWithoutLearnerActsWithVersionZero) {
+  const auto rc = smallConfig(5);
+  transport::Transport bus("memq://");
+  Capture cap(bus);
+  auto opt = options(2, 1);
+  opt.start_without_learner = true;
+  actor::Actor actor(rc, opt, &bus);
+  EXPECT_EQ(actor.run(), 1);
+  bus.drain();
+  ASSERT_FALSE(cap.chunks.empty());
+  EXPECT_EQ(decode(cap.chunks[0]).policy_version, 0);
+}
+
+TEST(ActorRollouts, StopFlagEndsTheRunBetweenSteps) {
+  const auto rc = smallConfig(6);
+  transport::Transport bus("memq://");
+  Capture cap(bus);
+  std::atomic<bool> stop{false};
+  auto opt = options(2, -1);
+  opt.start_without_learner = true;
+  opt.stop = &stop;
+  opt.after_step = [&](int64_t seq, int t) {
+    if (seq == 1 && t == 2) stop = true;
+  };
+  actor::Actor actor(rc, opt, &bus);
+  EXPECT_EQ(actor.run(), 1) << "the interrupted rollout is not sent";
+}
+
+}  // namespace
+}  // namespace masa
