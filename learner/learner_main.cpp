@@ -13,6 +13,7 @@
 
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
+#include "common/transport/lcm_url.hpp"
 #include "learner/learner.hpp"
 
 namespace {
@@ -45,7 +46,9 @@ int main(int argc, char** argv) {
   app.add_option("--configs", configs, "configs directory (defaults.yaml, tasks/, specs/)");
   app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_<timestamp>)");
   app.add_option("--resume", resume_dir, "continue the run in this directory from its checkpoint.bin");
-  app.add_option("--url", url, "LCM provider URL (default: LCM_DEFAULT_URL or LCM's default)");
+  // The same default as masa_actor: loopback multicast with a receive buffer large enough for chunks.
+  url = masa::transport::loopbackUrl();
+  app.add_option("--url", url, "LCM provider URL")->capture_default_str();
   app.add_option("--run-id", run_id, "run id actors must carry (default: random, or the checkpoint's)");
   app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_epochs)");
   app.add_option("--checkpoint-every", checkpoint_every, "updates between checkpoints (0: only on exit)");
