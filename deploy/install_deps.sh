@@ -16,8 +16,10 @@ packages=(
   liblcm-dev libglib2.0-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
-  # offscreen rendering of rollouts, plots
+  # offscreen rendering of rollouts
   libglfw3-dev xvfb xauth ffmpeg libpng-dev
+  # the run directory's learning_curve.png
+  gnuplot-nox
 )
 
 missing=()

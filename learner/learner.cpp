@@ -82,11 +82,9 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   buffer_ = std::make_unique<ppo::RolloutBuffer>(rc_.ppo.num_envs, rc_.ppo.horizon, model_->obsDim(), model_->actDim());
 
   run_id_ = options.run_id;
-  if (opt_.resume) {
-    loadCheckpoint();  // sets run_id_ unless one was given
-  } else {
-    std::ofstream(fs::path(dir_) / "config.yaml") << config::dumpResolved(rc_);
-  }
+  if (opt_.resume) loadCheckpoint();  // sets run_id_ unless one was given
+  // Rewritten on resume too: overrides given then are part of the run from now on.
+  std::ofstream(fs::path(dir_) / "config.yaml") << config::dumpResolved(rc_);
   if (run_id_ == 0) run_id_ = randomRunId();
   assembler_ = std::make_unique<transport::RolloutAssembler>(assemblerConfig(run_id_, rc_, model_->obsDim(), model_->actDim()));
   assembler_->setLearnerVersion(version_);
@@ -137,16 +135,21 @@ bool Learner::step(int timeout_ms) {
     updated = true;
   }
   const auto now = std::chrono::steady_clock::now();
-  if (std::chrono::duration<double>(now - last_publish_).count() >= opt_.republish_interval_s) publishParams();
+  if (std::chrono::duration<double>(now - last_publish_).count() >= rc_.runner.republish_every_s) publishParams();
   return updated;
 }
 
 void Learner::run(int64_t max_updates, const std::atomic<bool>* stop) {
+  max_updates_ = max_updates;
   while (epoch_ < max_updates && !(stop && stop->load())) step(100);
   writeCheckpoint();
+  renderLearningCurve();
 }
 
-void Learner::fillBuffer(const transport::ActorRollout& d) {
+bool Learner::renderLearningCurve() { return curve_ && curve_->renderAndWait(); }
+
+void Learner::fillBuffer(const transport::RolloutBatch& batch) {
+  const transport::ActorRollout& d = batch.data;
   ppo::RolloutBuffer& b = *buffer_;
   const int E = d.num_envs, T = d.horizon, od = d.obs_dim, ad = d.act_dim;
   MASA_CHECK(E == b.numEnvs() && T == b.horizon() && od == b.obsDim() && ad == b.actDim(),
@@ -163,8 +166,11 @@ void Learner::fillBuffer(const transport::ActorRollout& d) {
     b.terminated().data()[i] = d.terminated[i] != 0;
     b.truncated().data()[i] = d.truncated[i] != 0;
   }
-  // One behaviour log-std per batch (environment 0's): exact when max_policy_lag = 0.
-  for (int k = 0; k < ad; ++k) b.logStd()(k) = d.log_std[k];
+  // Each environment's own behaviour log-std: with max_policy_lag > 0 the batch mixes versions.
+  MASA_CHECK(batch.env_log_std.size() == static_cast<std::size_t>(E) * ad, "batch without per-env log-std");
+  for (int t = 0; t < T; ++t)
+    for (int e = 0; e < E; ++e)
+      b.logStds().col(b.column(t, e)) = Eigen::Map<const Vec<float>>(batch.env_log_std.data() + static_cast<std::size_t>(e) * ad, ad);
   b.clear();
   for (int i = 0; i < d.numFinal(); ++i) {
     const int idx = d.final_index[i];
@@ -192,12 +198,16 @@ void Learner::summarizeEpisodes(const transport::ActorRollout& d) {
     report_.mean_return /= n;
     report_.mean_length /= n;
     for (double& t : report_.term_means) t /= n;
+  } else {
+    // No episode ended in this batch: there is no return to report (0 would read as one).
+    report_.mean_return = report_.mean_length = std::nan("");
+    for (double& t : report_.term_means) t = std::nan("");
   }
   report_.success_rate = measured > 0 ? static_cast<double>(succeeded) / measured : -1.0;
 }
 
 void Learner::update(const transport::RolloutBatch& batch) {
-  fillBuffer(batch.data);
+  fillBuffer(batch);
   trainer_->prepare(*buffer_);
   if (!restored_order_.empty()) {
     // A resumed run continues the shuffle of the run it resumes (see PpoTrainer::shuffleOrder).
@@ -218,6 +228,8 @@ void Learner::update(const transport::RolloutBatch& batch) {
   report_.env_steps = env_steps_;
   report_.wall_time_s = wallTime();
   report_.fps = dt > 0 ? steps / dt : 0.0;
+  // The first interval includes start-up; later ones weigh in with a short memory.
+  update_interval_s_ = epoch_ <= 2 ? dt : 0.8 * update_interval_s_ + 0.2 * dt;
   summarizeEpisodes(batch.data);
   report_.dropped = droppedTotal();
 
@@ -226,16 +238,26 @@ void Learner::update(const transport::RolloutBatch& batch) {
   publishParams();
   publishStats();
   appendCsv();
+  if (!curve_)
+    curve_ = std::make_unique<LearningCurve>(dir_, rc_.task + " / " + model::methodName(rc_.method),
+                                             collector_->config().term_names);
+  if (rc_.runner.plot_every > 0 && epoch_ % rc_.runner.plot_every == 0) curve_->renderAsync();
   if (opt_.verbose) {
-    std::printf("epoch %lld  v%lld  steps %lld  fps %.0f  return %.3f  len %.1f  success %.2f  kl %.5f  lr %.2e  "
-                "actor %.4f  critic %.4f  dropped %lld\n",
-                static_cast<long long>(report_.epoch), static_cast<long long>(version_),
-                static_cast<long long>(env_steps_), report_.fps, report_.mean_return, report_.mean_length,
-                report_.success_rate, report_.ppo.kl, report_.ppo.lr, report_.ppo.actor_loss, report_.ppo.critic_loss,
-                static_cast<long long>(report_.dropped));
+    char eta[32] = "";
+    if (max_updates_ > epoch_) {
+      const long remaining = std::lround(update_interval_s_ * static_cast<double>(max_updates_ - epoch_));
+      std::snprintf(eta, sizeof(eta), "  eta %ld:%02ld:%02ld", remaining / 3600, remaining / 60 % 60, remaining % 60);
+    }
+    char total[32] = "";
+    if (max_updates_ > 0) std::snprintf(total, sizeof(total), "/%lld", static_cast<long long>(max_updates_));
+    std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f  success %.2f  kl %.5f  lr %.2e  "
+                "actor %.4f  critic %.4f  dropped %lld%s\n",
+                static_cast<long long>(epoch_), total, static_cast<long long>(env_steps_), report_.fps,
+                report_.mean_return, report_.mean_length, report_.success_rate, report_.ppo.kl, report_.ppo.lr,
+                report_.ppo.actor_loss, report_.ppo.critic_loss, static_cast<long long>(report_.dropped), eta);
     std::fflush(stdout);
   }
-  if (opt_.checkpoint_every > 0 && epoch_ % opt_.checkpoint_every == 0) writeCheckpoint();
+  if (rc_.runner.checkpoint_every > 0 && epoch_ % rc_.runner.checkpoint_every == 0) writeCheckpoint();
 }
 
 void Learner::publishParams() {

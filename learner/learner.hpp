@@ -23,6 +23,7 @@
 #include "common/transport/batch_collector.hpp"
 #include "common/transport/rollout_assembler.hpp"
 #include "common/transport/transport.hpp"
+#include "learner/learning_curve.hpp"
 #include "learner/ppo/ppo_trainer.hpp"
 #include "learner/ppo/rollout_buffer.hpp"
 
@@ -33,8 +34,6 @@ struct LearnerOptions {
   std::string run_dir;        // created if missing
   int64_t run_id = 0;         // 0: random from the clock, or the checkpoint's when resuming
   bool resume = false;        // load <run_dir>/checkpoint.bin and append to metrics.csv
-  int checkpoint_every = 10;  // updates between checkpoints (0: only on exit / explicit calls)
-  double republish_interval_s = 1.0;
   bool verbose = true;  // one progress line per update on stdout
 };
 
@@ -61,11 +60,15 @@ class Learner {
   // when an update ran.
   bool step(int timeout_ms);
   // step() until `max_updates` updates have run in total (counting resumed ones) or *stop is set;
-  // then checkpoints.
+  // then checkpoints and renders the learning curve.
   void run(int64_t max_updates, const std::atomic<bool>* stop);
 
   void writeCheckpoint();
   void publishParams();
+  // The total number of updates planned, for the progress line's ETA (run() sets it too).
+  void setMaxUpdates(int64_t max_updates) { max_updates_ = max_updates; }
+  // Renders <run dir>/learning_curve.png now (false without gnuplot or before the first update).
+  bool renderLearningCurve();
 
   transport::Transport& transport() { return *transport_; }
   int64_t runId() const { return run_id_; }
@@ -82,7 +85,7 @@ class Learner {
  private:
   void onChunk(const void* data, int size);
   void update(const transport::RolloutBatch& batch);
-  void fillBuffer(const transport::ActorRollout& d);
+  void fillBuffer(const transport::RolloutBatch& batch);
   void summarizeEpisodes(const transport::ActorRollout& d);
   void publishStats();
   void appendCsv();
@@ -110,6 +113,9 @@ class Learner {
   double wall_offset_s_ = 0;  // wall time of the runs before a resume
   std::chrono::steady_clock::time_point start_, last_update_, last_publish_;
   std::vector<int> restored_order_;  // shuffle permutation from a checkpoint, used once
+  std::unique_ptr<LearningCurve> curve_;  // made with the first update: it needs the reward terms
+  int64_t max_updates_ = -1;              // of the current run(), for the ETA; -1: unknown
+  double update_interval_s_ = 0;          // moving average of the wall time between updates
   UpdateReport report_;
 };
 

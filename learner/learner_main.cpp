@@ -13,6 +13,7 @@
 
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
+#include "common/transport/drop_reason.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "learner/learner.hpp"
 
@@ -41,25 +42,24 @@ int main(int argc, char** argv) {
   std::string run_dir, resume_dir, url;
   int64_t run_id = 0;
   int64_t max_updates = -1;
-  int checkpoint_every = 10;
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set ppo.horizon=8");
   app.add_option("--configs", configs, "configs directory (defaults.yaml, tasks/, specs/)");
   app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_<timestamp>)");
-  app.add_option("--resume", resume_dir, "continue the run in this directory from its checkpoint.bin");
+  app.add_option("--resume", resume_dir, "continue the run in this directory from its checkpoint.bin, with its config.yaml (--set still applies)");
   // The same default as masa_actor: loopback multicast with a receive buffer large enough for chunks.
   url = masa::transport::loopbackUrl();
   app.add_option("--url", url, "LCM provider URL")->capture_default_str();
   app.add_option("--run-id", run_id, "run id actors must carry (default: random, or the checkpoint's)");
   app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_epochs)");
-  app.add_option("--checkpoint-every", checkpoint_every, "updates between checkpoints (0: only on exit)");
   CLI11_PARSE(app, argc, argv);
 
   try {
-    const auto rc = masa::config::loadRunConfig(configs, overrides);
+    // A resumed run reads its own config.yaml: the run goes on with the settings it started with.
+    const std::string base = resume_dir.empty() ? "" : resume_dir + "/config.yaml";
+    const auto rc = masa::config::loadRunConfig(configs, overrides, base);
     masa::learner::LearnerOptions opt;
     opt.url = url;
     opt.run_id = run_id;
-    opt.checkpoint_every = checkpoint_every;
     if (!resume_dir.empty()) {
       opt.resume = true;
       opt.run_dir = resume_dir;
@@ -78,6 +78,14 @@ int main(int argc, char** argv) {
     // run() finishes the step in progress when a signal arrives, then checkpoints.
     learner.run(max_updates, &g_stop);
     std::cout << "masa_learner: stopped after " << learner.epoch() << " updates; checkpoint written" << std::endl;
+    // What became of the actors' rollout chunks, by reason (lost: never arrived).
+    const auto& drops = learner.dropStats();
+    std::cout << "masa_learner: rollout chunks accepted " << drops[masa::transport::DropReason::kAccepted];
+    for (int r = 1; r < masa::transport::kNumDropReasons; ++r) {
+      const auto reason = static_cast<masa::transport::DropReason>(r);
+      if (drops[reason] > 0) std::cout << ", " << masa::transport::dropReasonName(reason) << " " << drops[reason];
+    }
+    std::cout << std::endl;
   } catch (const std::exception& e) {
     std::cerr << "masa_learner: " << e.what() << "\n";
     return 2;

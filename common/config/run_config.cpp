@@ -153,7 +153,8 @@ std::string defaultConfigsDir() {
   return std::string(MASA_SOURCE_DIR) + "/configs";
 }
 
-RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides) {
+RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides,
+                        const std::string& base_file) {
   const std::string defaults_file = configs_dir + "/defaults.yaml";
   const YAML::Node schema = loadYamlFile(defaults_file, "(file)");
   RunConfig rc;
@@ -161,7 +162,11 @@ RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::s
 
   // Parse overrides first: the task they name decides which task file is read.
   std::vector<std::pair<std::string, YAML::Node>> parsed;
-  std::string task = schema["task"].as<std::string>();
+  // A run's own config.yaml (resume) replaces the task file as the middle layer: it already holds
+  // the task file's values as they were when the run started.
+  YAML::Node base;
+  if (!base_file.empty()) base = loadYamlFile(base_file, "(file)");
+  std::string task = base && base["task"] ? base["task"].as<std::string>() : schema["task"].as<std::string>();
   for (const std::string& o : overrides) {
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0)
@@ -177,7 +182,7 @@ RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::s
     parsed.emplace_back(path, value);
   }
 
-  const std::string task_file = configs_dir + "/tasks/" + task + ".yaml";
+  const std::string task_file = base_file.empty() ? configs_dir + "/tasks/" + task + ".yaml" : base_file;
   if (!fs::exists(task_file)) {
     std::string known;
     if (fs::exists(configs_dir + "/tasks"))
@@ -258,6 +263,11 @@ RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::s
   p.value_bootstrap = r.get<bool>("ppo.value_bootstrap", "true or false");
   p.max_epochs = r.atLeast("ppo.max_epochs", 1);
   p.max_policy_lag = r.atLeast("ppo.max_policy_lag", 0);
+
+  RunnerConfig& u = rc.runner;
+  u.checkpoint_every = r.atLeast("runner.checkpoint_every", 0);
+  u.republish_every_s = r.positive("runner.republish_every_s");
+  u.plot_every = r.atLeast("runner.plot_every", 0);
 
   rc.env = YAML::Clone(merged["env"]);
   rc.resolved = merged;

@@ -40,6 +40,13 @@ struct PpoConfig {
   int max_policy_lag = 0;
 };
 
+// The learner's bookkeeping around the algorithm (rsl_rl's "runner").
+struct RunnerConfig {
+  int checkpoint_every = 10;       // updates between checkpoints (0: only on exit)
+  double republish_every_s = 1.0;  // seconds between parameter re-broadcasts
+  int plot_every = 10;             // updates between learning-curve renders (0: only on exit)
+};
+
 struct RunConfig {
   std::string task;
   model::Method method = model::Method::kMasa;
@@ -47,6 +54,7 @@ struct RunConfig {
   std::string spec_path;  // resolved: absolute or relative to the configs dir's parent
   model::ModelConfig model;
   PpoConfig ppo;
+  RunnerConfig runner;
   YAML::Node env;         // task parameters, read by the task
   YAML::Node resolved;    // the whole merged tree, for the run directory
   std::map<std::string, std::string> origin;  // key path -> file (or "command line") that set it
@@ -54,7 +62,10 @@ struct RunConfig {
 
 // configs_dir holds defaults.yaml, tasks/ and specs/. overrides are "a.b=value" strings where value
 // is YAML (1e-4, true, [256, 128], elu).
-RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides);
+// base_file, when given, is read instead of the task file: a run directory's config.yaml, so that a
+// resumed run continues with exactly the configuration it started with (overrides still apply).
+RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides,
+                        const std::string& base_file = "");
 
 // The configs directory of this source tree (MASA_SOURCE_DIR/configs) unless MASA_CONFIGS is set.
 std::string defaultConfigsDir();

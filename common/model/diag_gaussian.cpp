@@ -71,21 +71,31 @@ void sample(const ConstMatRef<S>& mean, const ConstVecRef<S>& log_std, Rng& rng,
 }
 
 template <typename S>
-void kl(const ConstMatRef<S>& mean_old, const ConstVecRef<S>& log_std_old, const ConstMatRef<S>& mean_new,
+void kl(const ConstMatRef<S>& mean_old, const ConstMatRef<S>& log_std_old, const ConstMatRef<S>& mean_new,
         const ConstVecRef<S>& log_std_new, MatRef<S> out) {
-  checkShapes<S>(mean_old, log_std_old, mean_new);
-  MASA_CHECK(log_std_new.size() == log_std_old.size(), "log_std sizes differ");
-  MASA_CHECK(out.rows() == 1 && out.cols() == mean_old.cols(), "kl output must be 1 x batch");
+  const Eigen::Index a = mean_old.rows(), B = mean_old.cols();
+  MASA_CHECK(mean_new.rows() == a && mean_new.cols() == B,
+             "mean_new is " << mean_new.rows() << "x" << mean_new.cols() << ", mean_old " << a << "x" << B);
+  MASA_CHECK(log_std_new.size() == a, "log_std_new has " << log_std_new.size() << " entries, mean " << a << " rows");
+  MASA_CHECK(log_std_old.rows() == a && (log_std_old.cols() == 1 || log_std_old.cols() == B),
+             "log_std_old must be " << a << " x 1 or " << a << " x " << B << ", got " << log_std_old.rows() << "x"
+                                    << log_std_old.cols());
+  MASA_CHECK(out.rows() == 1 && out.cols() == B, "kl output must be 1 x batch");
   // KL = sum_d log(s_new/s_old) + (s_old^2 + (mu_old - mu_new)^2) / (2 s_new^2) - 1/2
-  const Eigen::Index a = mean_old.rows();
-  S constant = S(0);
-  for (Eigen::Index d = 0; d < a; ++d)
-    constant += log_std_new(d) - log_std_old(d) + S(0.5) * std::exp(S(2) * (log_std_old(d) - log_std_new(d))) - S(0.5);
-  for (Eigen::Index b = 0; b < mean_old.cols(); ++b) {
-    S acc = S(0);
+  const bool shared = log_std_old.cols() == 1;
+  S shared_constant = S(0);
+  if (shared)
+    for (Eigen::Index d = 0; d < a; ++d)
+      shared_constant += log_std_new(d) - log_std_old(d, 0) +
+                         S(0.5) * std::exp(S(2) * (log_std_old(d, 0) - log_std_new(d))) - S(0.5);
+  for (Eigen::Index b = 0; b < B; ++b) {
+    S acc = S(0), constant = shared_constant;
     for (Eigen::Index d = 0; d < a; ++d) {
       const S diff = mean_old(d, b) - mean_new(d, b);
       acc += diff * diff * std::exp(S(-2) * log_std_new(d));
+      if (!shared)
+        constant += log_std_new(d) - log_std_old(d, b) +
+                    S(0.5) * std::exp(S(2) * (log_std_old(d, b) - log_std_new(d))) - S(0.5);
     }
     out(0, b) = S(0.5) * acc + constant;
   }
@@ -97,7 +107,7 @@ void kl(const ConstMatRef<S>& mean_old, const ConstVecRef<S>& log_std_old, const
                                    const ConstMatRef<S>&, MatRef<S>, VecRef<S>);                                 \
   template S entropy<S>(const ConstVecRef<S>&);                                                                 \
   template void sample<S>(const ConstMatRef<S>&, const ConstVecRef<S>&, Rng&, MatRef<S>);                        \
-  template void kl<S>(const ConstMatRef<S>&, const ConstVecRef<S>&, const ConstMatRef<S>&, const ConstVecRef<S>&, \
+  template void kl<S>(const ConstMatRef<S>&, const ConstMatRef<S>&, const ConstMatRef<S>&, const ConstVecRef<S>&, \
                       MatRef<S>);
 MASA_INSTANTIATE(float)
 MASA_INSTANTIATE(double)

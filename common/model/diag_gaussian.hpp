@@ -24,9 +24,10 @@ S entropy(const ConstVecRef<S>& log_std);
 template <typename S>
 void sample(const ConstMatRef<S>& mean, const ConstVecRef<S>& log_std, Rng& rng, MatRef<S> out);
 
-// KL(old || new) per column.
+// KL(old || new) per column. log_std_old is act x 1 (one behaviour policy for the whole batch) or
+// act x B (one per sample: rollouts of several policy versions mixed in one batch).
 template <typename S>
-void kl(const ConstMatRef<S>& mean_old, const ConstVecRef<S>& log_std_old, const ConstMatRef<S>& mean_new,
+void kl(const ConstMatRef<S>& mean_old, const ConstMatRef<S>& log_std_old, const ConstMatRef<S>& mean_new,
         const ConstVecRef<S>& log_std_new, MatRef<S> out);
 
 }  // namespace masa::model::gaussian

@@ -28,7 +28,7 @@ PpoLossStats PpoLoss<S>::compute(const PpoLossBatch<S>& in) {
   MASA_CHECK(B > 0 && B <= max_batch_, "minibatch of " << B << " samples, loss sized for " << max_batch_);
   MASA_CHECK(in.mean.rows() == act_dim_ && in.actions.rows() == act_dim_ && in.actions.cols() == B &&
                  in.old_mean.rows() == act_dim_ && in.old_mean.cols() == B && in.log_std.size() == act_dim_ &&
-                 in.old_log_std.size() == act_dim_,
+                 in.old_log_std.rows() == act_dim_ && (in.old_log_std.cols() == 1 || in.old_log_std.cols() == B),
              "policy inputs must be " << act_dim_ << " x " << B);
   auto row = [&](const ConstMatRef<S>& m) { return m.rows() == 1 && m.cols() == B; };
   MASA_CHECK(row(in.value) && row(in.old_log_prob) && row(in.advantages) && row(in.old_value) && row(in.returns),

@@ -37,7 +37,7 @@ struct PpoLossBatch {
   ConstMatRef<S> actions;       // act x B
   ConstMatRef<S> old_log_prob;  // 1 x B, behaviour policy
   ConstMatRef<S> old_mean;      // act x B, behaviour policy
-  ConstVecRef<S> old_log_std;   // act, behaviour policy
+  ConstMatRef<S> old_log_std;   // act x 1 or act x B, behaviour policy (see gaussian::kl)
   ConstMatRef<S> advantages;    // 1 x B
   ConstMatRef<S> old_value;     // 1 x B, critic before the update (same units as value)
   ConstMatRef<S> returns;       // 1 x B (same units as value)

@@ -51,6 +51,7 @@ PpoTrainer::PpoTrainer(model::ActorCritic<float>& model, nn::Adam<float>& adam, 
   mb_obs_.resize(o, m);
   mb_actions_.resize(a, m);
   mb_old_mean_.resize(a, m);
+  mb_old_log_std_.resize(a, m);
   mb_old_log_prob_.resize(1, m);
   mb_adv_.resize(1, m);
   mb_old_value_.resize(1, m);
@@ -165,6 +166,7 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
   const Mat<float>& obs = buffer.obs();
   const Mat<float>& actions = buffer.actions();
   const Mat<float>& means = buffer.means();
+  const Mat<float>& old_log_stds = buffer.logStds();
   const Mat<float>& log_probs = buffer.logProbs();
   PpoStats st = prepared_;
 
@@ -179,6 +181,7 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
         mb_obs_.col(j) = obs.col(c);
         mb_actions_.col(j) = actions.col(c);
         mb_old_mean_.col(j) = means.col(c);
+        mb_old_log_std_.col(j) = old_log_stds.col(c);
         mb_old_log_prob_(0, j) = log_probs(0, c);
         mb_adv_(0, j) = advantages_(0, c);
         mb_old_value_(0, j) = old_values_(0, c);
@@ -188,7 +191,7 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
       model.forward(mb_obs_);
       model.logStd(log_std_);
       const PpoLossBatch<float> batch{model.mean(), log_std_,   model.value(), mb_actions_,   mb_old_log_prob_,
-                                      mb_old_mean_, buffer.logStd(), mb_adv_, mb_old_value_, mb_returns_};
+                                      mb_old_mean_, mb_old_log_std_, mb_adv_, mb_old_value_, mb_returns_};
       const PpoLossStats ls = loss_.compute(batch);
 
       params.zeroGrad();

@@ -79,7 +79,7 @@ class PpoTrainer {
   std::vector<int> order_;                        // minibatch shuffle
 
   // Per minibatch.
-  Mat<float> mb_obs_, mb_actions_, mb_old_mean_, mb_old_log_prob_, mb_adv_, mb_old_value_, mb_returns_;
+  Mat<float> mb_obs_, mb_actions_, mb_old_mean_, mb_old_log_std_, mb_old_log_prob_, mb_adv_, mb_old_value_, mb_returns_;
   Vec<float> log_std_;
 };
 

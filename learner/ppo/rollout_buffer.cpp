@@ -16,7 +16,7 @@ RolloutBuffer::RolloutBuffer(int num_envs, int horizon, int obs_dim, int act_dim
   actions_ = Mat<Scalar>::Zero(act_dim, n);
   means_ = Mat<Scalar>::Zero(act_dim, n);
   log_probs_ = Mat<Scalar>::Zero(1, n);
-  log_std_ = Vec<Scalar>::Zero(act_dim);
+  log_stds_ = Mat<Scalar>::Zero(act_dim, n);
   rewards_ = StepMat<Scalar>::Zero(horizon, num_envs);
   terminated_ = FlagMat::Zero(horizon, num_envs);
   truncated_ = FlagMat::Zero(horizon, num_envs);

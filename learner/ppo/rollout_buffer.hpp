@@ -44,7 +44,9 @@ class RolloutBuffer {
   Mat<Scalar>& actions() { return actions_; }            // act_dim x T*E
   Mat<Scalar>& means() { return means_; }                // act_dim x T*E, behaviour policy means
   Mat<Scalar>& logProbs() { return log_probs_; }         // 1 x T*E, behaviour log-probs
-  Vec<Scalar>& logStd() { return log_std_; }             // act_dim, behaviour log-std of the rollout
+  // act_dim x T*E, behaviour log-std of each sample: with max_policy_lag > 0 one batch mixes
+  // rollouts of several policy versions, each with its own state-independent std.
+  Mat<Scalar>& logStds() { return log_stds_; }
   StepMat<Scalar>& rewards() { return rewards_; }        // T x E
   FlagMat& terminated() { return terminated_; }          // T x E, 1 where the episode ended for good
   FlagMat& truncated() { return truncated_; }            // T x E, 1 where it hit the time limit
@@ -56,7 +58,7 @@ class RolloutBuffer {
   const Mat<Scalar>& actions() const { return actions_; }
   const Mat<Scalar>& means() const { return means_; }
   const Mat<Scalar>& logProbs() const { return log_probs_; }
-  const Vec<Scalar>& logStd() const { return log_std_; }
+  const Mat<Scalar>& logStds() const { return log_stds_; }
   const StepMat<Scalar>& rewards() const { return rewards_; }
   const FlagMat& terminated() const { return terminated_; }
   const FlagMat& truncated() const { return truncated_; }
@@ -78,8 +80,7 @@ class RolloutBuffer {
 
  private:
   int num_envs_, horizon_, obs_dim_, act_dim_;
-  Mat<Scalar> obs_, actions_, means_, log_probs_;
-  Vec<Scalar> log_std_;
+  Mat<Scalar> obs_, actions_, means_, log_probs_, log_stds_;
   StepMat<Scalar> rewards_;
   FlagMat terminated_, truncated_;
   Mat<Scalar> bootstrap_obs_;

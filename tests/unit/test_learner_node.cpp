@@ -194,14 +194,13 @@ TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTri
 }
 
 TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv) {
-  const auto rc = smallConfig();
+  auto rc = smallConfig();
+  rc.runner.checkpoint_every = 1;
   const fs::path dir_a = freshDir("ckpt_a"), dir_b = freshDir("ckpt_b");
   FakeActor first(rc, 10), second(rc, 11);
   std::vector<float> params_a;
   {
-    LearnerOptions o = options(dir_a, 9);
-    o.checkpoint_every = 1;
-    Learner a(rc, o);
+    Learner a(rc, options(dir_a, 9));
     first.send(a.transport(), 9, 0, 0);
     ASSERT_TRUE(stepUntilUpdate(a));
     ASSERT_TRUE(fs::exists(dir_a / "checkpoint.bin"));

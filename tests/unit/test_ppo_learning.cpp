@@ -75,15 +75,17 @@ class MirrorBandit {
 double collect(model::ActorCritic<float>& model, MirrorBandit& env, RolloutBuffer& buffer, Rng& rng) {
   buffer.clear();
   const int E = buffer.numEnvs();
-  model.logStd(buffer.logStd());
+  Vec<float> log_std(buffer.actDim());
+  model.logStd(log_std);
+  buffer.logStds().colwise() = log_std;
   for (int t = 0; t < buffer.horizon(); ++t) {
     auto obs = buffer.obs().middleCols(t * E, E);
     auto means = buffer.means().middleCols(t * E, E);
     auto actions = buffer.actions().middleCols(t * E, E);
     obs = env.obs();
     means = model.actMean(obs);
-    model::gaussian::sample<float>(means, buffer.logStd(), rng, actions);
-    model::gaussian::logProb<float>(means, buffer.logStd(), actions, buffer.logProbs().middleCols(t * E, E));
+    model::gaussian::sample<float>(means, log_std, rng, actions);
+    model::gaussian::logProb<float>(means, log_std, actions, buffer.logProbs().middleCols(t * E, E));
     env.step(actions, t, buffer, rng);
   }
   buffer.bootstrapObs() = env.obs();

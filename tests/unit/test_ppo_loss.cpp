@@ -166,5 +166,28 @@ TEST(PpoLossParts, KlIsOldToNewAndPositiveWhenThePolicyMoves) {
   EXPECT_NEAR(st.kl, kl.mean(), 1e-12);
 }
 
+// With max_policy_lag > 0 a minibatch mixes samples of several policy versions: each sample's KL
+// must be measured from its own behaviour std, not from one shared std.
+TEST(PpoLossParts, KlUsesEachSamplesOwnBehaviourStd) {
+  Inputs in = regimeCoveringInputs();
+  Mat<double> per_sample(kAct, kBatch);
+  for (int b = 0; b < kBatch; ++b) per_sample.col(b) = in.old_log_std.array() + 0.1 * b;
+  const PpoLossBatch<double> batch{in.mean,     in.log_std,    in.value,      in.actions,    in.old_log_prob,
+                                   in.old_mean, per_sample,    in.advantages, in.old_value,  in.returns};
+  PpoLoss<double> loss(lossConfig(), kAct, kBatch);
+  const PpoLossStats st = loss.compute(batch);
+  double expected = 0;
+  for (int b = 0; b < kBatch; ++b) {
+    Mat<double> one(1, 1);
+    model::gaussian::kl<double>(in.old_mean.col(b), per_sample.col(b), in.mean.col(b), in.log_std, one);
+    expected += one(0, 0);
+  }
+  EXPECT_NEAR(st.kl, expected / kBatch, 1e-12);
+  // The shared-std answer (every sample with sample 0's std) is measurably different.
+  Mat<double> shared(1, kBatch);
+  model::gaussian::kl<double>(in.old_mean, per_sample.col(0), in.mean, in.log_std, shared);
+  EXPECT_GT(std::abs(st.kl - shared.mean()), 1e-3);
+}
+
 }  // namespace
 }  // namespace masa::ppo

@@ -60,9 +60,11 @@ void fillOneStepBatch(Rig& s, Rng& rng) {
   b.bootstrapObs() = test::randomMatrix<float>(b.obsDim(), b.numEnvs(), rng);
   s.model->obsNormalizer().update(b.obs());
   b.means() = s.model->actMean(b.obs());
-  s.model->logStd(b.logStd());
-  model::gaussian::sample<float>(b.means(), b.logStd(), rng, b.actions());
-  model::gaussian::logProb<float>(b.means(), b.logStd(), b.actions(), b.logProbs());
+  Vec<float> log_std(b.actDim());
+  s.model->logStd(log_std);
+  b.logStds().colwise() = log_std;
+  model::gaussian::sample<float>(b.means(), log_std, rng, b.actions());
+  model::gaussian::logProb<float>(b.means(), log_std, b.actions(), b.logProbs());
   for (int t = 0; t < b.horizon(); ++t)
     for (int e = 0; e < b.numEnvs(); ++e) b.rewards()(t, e) = b.obs()(kInvariantObs, b.column(t, e)) > 0 ? 1.f : -1.f;
   b.terminated().setOnes();

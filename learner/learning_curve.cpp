@@ -1,0 +1,148 @@
+#include "learner/learning_curve.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <spawn.h>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace masa::learner {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// gnuplot strings are double-quoted: keep a title from breaking out of them.
+std::string quoted(const std::string& s) {
+  std::string out;
+  for (char c : s)
+    if (c != '"' && c != '\\' && c != '\n') out += c;
+  return '"' + out + '"';
+}
+
+}  // namespace
+
+std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names) {
+  std::ostringstream g;
+  std::string terms;
+  for (const auto& t : term_names) terms += (terms.empty() ? "" : " ") + t;
+  g << "# Learning curves of a masa run, drawn from metrics.csv (written by masa_learner).\n"
+       "# Re-render inside the run directory with: gnuplot learning_curve.gp\n"
+       "set datafile separator \",\"\n"
+       "set terminal pngcairo size 1500,900 font \",10\"\n"
+       "set output \"learning_curve.png.tmp\"\n"
+       "set termoption noenhanced  # task and term names have underscores, not subscripts\n"
+       "set multiplot layout 2,3 title "
+    << quoted(title)
+    << "\n"
+       "set grid\n"
+       "set key top left\n"
+       "set xlabel \"env steps\"\n"
+       "set style data linespoints\n"
+       "set pointsize 0.4\n"
+       "# Updates in which no episode ended have no return: the CSV says nan there.\n"
+       "set title \"mean episode return\"\n"
+       "plot \"metrics.csv\" using \"env_steps\":\"return\" pt 7 lw 2 title \"return\"\n"
+       "set title \"mean episode length and success rate\"\n"
+       "set ytics nomirror\n"
+       "set y2tics\n"
+       "set y2range [0:1]\n"
+       "plot \"metrics.csv\" using \"env_steps\":\"length\" pt 7 title \"length\", \\\n"
+       "     \"\" using \"env_steps\":(column(\"success\") < 0 ? NaN : column(\"success\")) axes x1y2 pt 7 title \"success\"\n"
+       "unset y2tics\n"
+       "set ytics mirror\n"
+       "set title \"reward terms (mean per episode)\"\n"
+       "set key top left font \",8\"\n";
+  if (term_names.empty())
+    g << "plot \"metrics.csv\" using \"env_steps\":\"return\" pt 7 title \"return\"\n";
+  else
+    g << "plot for [t in " << quoted(terms) << "] \"metrics.csv\" using \"env_steps\":(column(\"term_\".t)) pt 7 title t\n";
+  g << "set key top left font \",10\"\n"
+       "set title \"losses\"\n"
+       "plot \"metrics.csv\" using \"env_steps\":\"actor_loss\" pt 7 title \"actor\", \\\n"
+       "     \"\" using \"env_steps\":\"critic_loss\" pt 7 title \"critic\"\n"
+       "set title \"KL and learning rate\"\n"
+       "set logscale y\n"
+       "plot \"metrics.csv\" using \"env_steps\":\"kl\" pt 7 title \"KL(old||new)\", \\\n"
+       "     \"\" using \"env_steps\":\"lr\" pt 7 title \"learning rate\"\n"
+       "unset logscale y\n"
+       "set title \"throughput\"\n"
+       "plot \"metrics.csv\" using \"env_steps\":\"fps\" pt 7 title \"env steps / s\"\n"
+       "unset multiplot\n"
+       "set output\n"
+       "# Renamed only when complete, so a viewer never sees half a picture.\n"
+       "system(\"mv -f learning_curve.png.tmp learning_curve.png\")\n";
+  return g.str();
+}
+
+LearningCurve::LearningCurve(std::string run_dir, std::string title, std::vector<std::string> term_names)
+    : dir_(std::move(run_dir)) {
+  script_ = (fs::path(dir_) / "learning_curve.gp").string();
+  png_ = (fs::path(dir_) / "learning_curve.png").string();
+  writeScript(term_names, title);
+}
+
+LearningCurve::~LearningCurve() { reap(true); }
+
+void LearningCurve::writeScript(const std::vector<std::string>& term_names, const std::string& title) const {
+  std::ofstream(script_) << learningCurveScript(title, term_names);
+}
+
+bool LearningCurve::reap(bool block) {
+  if (child_ < 0) return true;
+  int status = 0;
+  const pid_t r = ::waitpid(child_, &status, block ? 0 : WNOHANG);
+  if (r == 0) return false;  // still running
+  child_ = -1;
+  last_status_ = r < 0 ? -1 : status;
+  if (r > 0 && !(WIFEXITED(status) && WEXITSTATUS(status) == 0))
+    std::cerr << "masa_learner: gnuplot failed to render " << png_ << " (run 'gnuplot learning_curve.gp' in the run "
+              << "directory to see why)\n";
+  return true;
+}
+
+bool LearningCurve::spawn() {
+  if (gnuplot_missing_) return false;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addchdir_np(&actions, dir_.c_str());  // the script names files relative to the run
+  // gnuplot's own chatter (warnings about empty columns early in a run) stays out of the progress output.
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "learning_curve.log", O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  char arg0[] = "gnuplot", arg1[] = "learning_curve.gp";
+  char* argv[] = {arg0, arg1, nullptr};
+  pid_t pid = -1;
+  const int err = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (err != 0) {
+    gnuplot_missing_ = true;
+    std::cerr << "masa_learner: cannot run gnuplot (" << std::strerror(err) << "): no learning_curve.png; install "
+              << "it with deploy/install_deps.sh (package gnuplot-nox)\n";
+    return false;
+  }
+  child_ = pid;
+  return true;
+}
+
+void LearningCurve::renderAsync() {
+  if (reap(false)) spawn();
+}
+
+bool LearningCurve::renderAndWait() {
+  reap(true);
+  std::error_code ec;
+  const auto before = fs::exists(png_, ec) ? fs::last_write_time(png_, ec) : fs::file_time_type::min();
+  if (!spawn()) return false;
+  reap(true);
+  return last_status_ == 0 && fs::exists(png_, ec) && fs::last_write_time(png_, ec) >= before;
+}
+
+}  // namespace masa::learner

@@ -1,0 +1,45 @@
+// The run directory's learning_curve.png, drawn from metrics.csv by gnuplot (Debian's gnuplot-nox).
+//
+// The learner writes learning_curve.gp next to metrics.csv (a user can edit and re-run it) and runs
+// gnuplot in the background so that training never waits for a plot: a render still running when
+// the next is due is simply skipped. The PNG is written to a temporary file and renamed, so a
+// reader never sees half a picture. Without gnuplot the learner warns once and trains on.
+#pragma once
+
+#include <string>
+#include <sys/types.h>
+#include <vector>
+
+namespace masa::learner {
+
+class LearningCurve {
+ public:
+  // term_names: the task's reward terms, as the metrics.csv columns term_<name>.
+  LearningCurve(std::string run_dir, std::string title, std::vector<std::string> term_names);
+  ~LearningCurve();  // waits for a render in flight
+  LearningCurve(const LearningCurve&) = delete;
+  LearningCurve& operator=(const LearningCurve&) = delete;
+
+  // Starts a render unless one is still running; never blocks.
+  void renderAsync();
+  // Renders now and waits (at the end of a run). Returns true when the PNG was written.
+  bool renderAndWait();
+
+  const std::string& scriptPath() const { return script_; }
+  const std::string& pngPath() const { return png_; }
+
+ private:
+  void writeScript(const std::vector<std::string>& term_names, const std::string& title) const;
+  bool reap(bool block);  // true when no render is running afterwards
+  bool spawn();
+
+  std::string dir_, script_, png_;
+  pid_t child_ = -1;
+  int last_status_ = 0;
+  bool gnuplot_missing_ = false;
+};
+
+// gnuplot script text for a metrics.csv with these reward terms (exposed for tests).
+std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names);
+
+}  // namespace masa::learner

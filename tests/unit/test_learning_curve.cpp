@@ -1,0 +1,107 @@
+// The run directory's learning_curve.png, rendered by gnuplot from metrics.csv.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include "learner/learning_curve.hpp"
+
+namespace masa::learner {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path freshDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("masa_test_curve_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// A metrics.csv as the learner writes it, with one update in which no episode ended (nan).
+void writeMetrics(const fs::path& dir, int rows) {
+  std::ofstream f(dir / "metrics.csv");
+  f << "epoch,version,env_steps,wall_time_s,fps,return,length,success,term_alive,term_velocity,actor_loss,"
+       "critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped\n";
+  for (int i = 0; i < rows; ++i) {
+    const bool ended = i != 1;
+    f << i << ',' << i + 1 << ',' << (i + 1) * 2048 << ',' << i * 0.5 << ",4000,";
+    if (ended)
+      f << 10.0 + i << ',' << 20 + i << ",-1," << 0.5 * i << ',' << 1.0 + i;
+    else
+      f << "nan,nan,-1,nan,nan";
+    f << ",-0.01,0.5,1.2,0,0,0,0.002,0.0005,0.8,0.3,0\n";
+  }
+}
+
+bool isPng(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  char magic[8] = {};
+  f.read(magic, 8);
+  return f && std::string(magic + 1, 3) == "PNG";
+}
+
+bool haveGnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
+
+TEST(LearningCurve, RendersAPngFromMetricsWithEveryRewardTerm) {
+  if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed (deploy/install_deps.sh installs gnuplot-nox)";
+  const fs::path dir = freshDir("render");
+  writeMetrics(dir, 6);
+  LearningCurve curve(dir.string(), "a1_beam / masa", {"alive", "velocity"});
+  const std::string script = [&] {
+    std::ifstream f(curve.scriptPath());
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  }();
+  EXPECT_NE(script.find("\"alive velocity\""), std::string::npos) << "the terms panel plots every reward term";
+  ASSERT_TRUE(curve.renderAndWait()) << "gnuplot log: " << (dir / "learning_curve.log");
+  EXPECT_TRUE(isPng(curve.pngPath()));
+  EXPECT_GT(fs::file_size(curve.pngPath()), 10000u);  // six panels, not an empty canvas
+  EXPECT_FALSE(fs::exists(dir / "learning_curve.png.tmp"));
+  fs::remove_all(dir);
+}
+
+TEST(LearningCurve, AsyncRenderDoesNotBlockAndIsCollectedByTheDestructor) {
+  if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
+  const fs::path dir = freshDir("async");
+  writeMetrics(dir, 4);
+  {
+    LearningCurve curve(dir.string(), "t", {"alive", "velocity"});
+    curve.renderAsync();
+    curve.renderAsync();  // skipped while the first is running, or a second render: either is fine
+  }
+  EXPECT_TRUE(isPng(dir / "learning_curve.png"));
+  fs::remove_all(dir);
+}
+
+TEST(LearningCurve, ABrokenMetricsFileFailsTheRenderInsteadOfWritingAPicture) {
+  if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
+  const fs::path dir = freshDir("broken");
+  std::ofstream(dir / "metrics.csv") << "not,the,columns\n1,2,3\n";
+  LearningCurve curve(dir.string(), "t", {"alive"});
+  EXPECT_FALSE(curve.renderAndWait());
+  EXPECT_FALSE(fs::exists(curve.pngPath()));
+  fs::remove_all(dir);
+}
+
+TEST(LearningCurve, WithoutGnuplotTheRenderReportsFailureAndTrainingGoesOn) {
+  const fs::path dir = freshDir("missing");
+  writeMetrics(dir, 3);
+  const char* old_path = std::getenv("PATH");
+  const std::string saved = old_path ? old_path : "";
+  ::setenv("PATH", dir.c_str(), 1);  // a PATH without gnuplot
+  {
+    LearningCurve curve(dir.string(), "t", {"alive"});
+    EXPECT_FALSE(curve.renderAndWait());
+    curve.renderAsync();  // warned once already: a no-op
+  }
+  ::setenv("PATH", saved.c_str(), 1);
+  EXPECT_FALSE(fs::exists(dir / "learning_curve.png"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace masa::learner
