@@ -49,6 +49,13 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
   if (horizon_ <= 0) throw std::runtime_error("actor: ppo.horizon must be positive, got " + std::to_string(horizon_));
   if (options_.actor_id < 0) throw std::runtime_error("actor: actor_id must be >= 0");
   if (options_.threads <= 0) throw std::runtime_error("actor: threads must be positive");
+  if (!(options_.drop_chunks_percent >= 0.0 && options_.drop_chunks_percent <= 100.0))
+    throw std::runtime_error("actor: drop_chunks_percent must be in [0, 100]");
+  if (options_.first_rollout_seq < 0 && options_.first_rollout_seq != kRolloutSeqFromClock)
+    throw std::runtime_error("actor: first_rollout_seq must be >= 0");
+  first_rollout_seq_ = options_.first_rollout_seq == kRolloutSeqFromClock ? transport::wallClockMicros()
+                                                                          : options_.first_rollout_seq;
+  drop_rng_.seed(options_.drop_seed);
 
   const auto spec = sym::SymmetrySpec::load(config_.spec_path);
   factory_ = std::make_unique<task::TaskFactory>(config_.task, spec, config_.env, config_.origin);
@@ -181,6 +188,16 @@ void Actor::maybeHeartbeat() {
   if (nowSeconds() - last_heartbeat_s_ >= options_.heartbeat_interval_s) publishHeartbeat();
 }
 
+void Actor::awaitNewerParams() {
+  const double deadline = nowSeconds() + options_.await_params_s;
+  for (double now = nowSeconds(); pending_version_ <= version_ && now < deadline && !stopRequested(); now = nowSeconds()) {
+    // Short slices: the stop flag and heartbeats are served while waiting.
+    transport_->handleTimeout(static_cast<int>(std::min(100.0, std::ceil((deadline - now) * 1000.0))));
+    transport_->drain();
+    maybeHeartbeat();
+  }
+}
+
 bool Actor::collectAndPublish() {
   swapInPending();  // the only place parameters change
   if (!hasParams()) throw std::logic_error("actor: collectAndPublish before any parameters");
@@ -247,9 +264,17 @@ bool Actor::collectAndPublish() {
   transport::RolloutIdentity id;
   id.run_id = options_.run_id;
   id.actor_id = options_.actor_id;
-  id.rollout_seq = rollouts_sent_;
+  id.rollout_seq = first_rollout_seq_ + rollouts_sent_;
   id.policy_version = acting_version;
-  for (const auto& chunk : chunker_.split(rollout_, id)) transport_->publish(transport::kRolloutChannel, chunk);
+  std::uniform_real_distribution<double> percent(0.0, 100.0);
+  for (const auto& chunk : chunker_.split(rollout_, id)) {
+    if (options_.drop_chunks_percent > 0.0 && percent(drop_rng_) < options_.drop_chunks_percent) {
+      ++chunks_dropped_;  // fault injection: as if the network had lost it
+      continue;
+    }
+    transport_->publish(transport::kRolloutChannel, chunk);
+    ++chunks_published_;
+  }
   ++rollouts_sent_;
   return true;
 }
@@ -260,6 +285,7 @@ int64_t Actor::run() {
   }
   while (!stopRequested() && (options_.max_rollouts < 0 || rollouts_sent_ < options_.max_rollouts)) {
     if (!collectAndPublish()) break;
+    if (options_.max_rollouts < 0 || rollouts_sent_ < options_.max_rollouts) awaitNewerParams();
   }
   publishHeartbeat();  // final state: version acted with, rollouts sent
   return rollouts_sent_;

@@ -27,6 +27,9 @@
 
 namespace masa::actor {
 
+// ActorOptions::first_rollout_seq: number rollouts from the wall clock (see there).
+inline constexpr int64_t kRolloutSeqFromClock = -1;
+
 struct ActorOptions {
   int actor_id = 0;
   int num_envs = 1;
@@ -37,9 +40,24 @@ struct ActorOptions {
   bool start_without_learner = false;  // act with own initial parameters as version 0
   double heartbeat_interval_s = 1.0;
   int chunk_bytes = transport::kDefaultChunkBytes;
+  // rollout_seq of the first rollout, +1 per rollout after it. kRolloutSeqFromClock: the wall clock
+  // in microseconds when the actor is made, so that an actor restarted with the same id numbers
+  // its rollouts far past its previous process's (the learner's duplicate filter would otherwise
+  // take them for replays) and the numbering jump tells the learner it restarted.
+  int64_t first_rollout_seq = kRolloutSeqFromClock;
+  // Fault injection for tests, off by default: this percentage of chunks is counted and thrown
+  // away instead of published, chosen by a generator seeded with drop_seed (reproducible).
+  double drop_chunks_percent = 0.0;
+  uint64_t drop_seed = 1;
+  // After each rollout, wait up to this long for parameters newer than the ones it acted with.
+  // Without the wait a fast actor collects rollouts the learner will drop as stale (with
+  // max_policy_lag 0, a third of the data in a 2-actor run). Bounded, so that a batch still fills
+  // when another actor is dead (at the cost of this wait per update). 0: never wait.
+  double await_params_s = 1.0;
   const std::atomic<bool>* stop = nullptr;  // checked between steps (signal handlers set it)
-  // Test hook: called after each step t of a rollout, before incoming messages are handled.
-  std::function<void(int64_t rollout_seq, int t)> after_step;
+  // Test hook: called after each step t of a rollout (rollout_index counts this actor's rollouts
+  // from 0, whatever first_rollout_seq is), before incoming messages are handled.
+  std::function<void(int64_t rollout_index, int t)> after_step;
 };
 
 class Actor {
@@ -65,6 +83,9 @@ class Actor {
   bool hasParams() const { return version_ >= 0; }
   int64_t policyVersion() const { return version_; }
   int64_t rolloutsSent() const { return rollouts_sent_; }
+  int64_t firstRolloutSeq() const { return first_rollout_seq_; }
+  int64_t chunksPublished() const { return chunks_published_; }
+  int64_t chunksDropped() const { return chunks_dropped_; }  // by drop_chunks_percent
   int64_t paramsRejected() const { return params_rejected_; }
   const transport::ActorRollout& lastRollout() const { return rollout_; }
   int numEnvs() const { return num_envs_; }
@@ -76,6 +97,7 @@ class Actor {
   void swapInPending();
   bool stopRequested() const { return options_.stop && options_.stop->load(std::memory_order_relaxed); }
   void maybeHeartbeat();
+  void awaitNewerParams();  // see ActorOptions::await_params_s
 
   config::RunConfig config_;
   ActorOptions options_;
@@ -111,6 +133,10 @@ class Actor {
   int64_t last_rejected_version_ = -1;
 
   int64_t rollouts_sent_ = 0;
+  int64_t first_rollout_seq_ = 0;
+  int64_t chunks_published_ = 0;
+  int64_t chunks_dropped_ = 0;
+  Rng drop_rng_;
   std::string hostname_;
   double last_heartbeat_s_ = -1e300;
   int64_t steps_since_heartbeat_ = 0;

@@ -26,6 +26,10 @@ int main(int argc, char** argv) {
   std::string configs = masa::config::defaultConfigsDir();
   app.add_option("--set", overrides, "config override key.path=value (task, method, seed, ppo.*; repeatable)");
   app.add_option("--configs", configs, "configs directory")->capture_default_str();
+  std::string run_config;
+  app.add_option("--run-config", run_config,
+                 "a run directory's config.yaml, read instead of the task file (to join a resumed run)")
+      ->check(CLI::ExistingFile);
   app.add_option("--actor-id", opt.actor_id, "actor index, 0-based")->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--num-envs", opt.num_envs, "environments simulated by this actor")
       ->capture_default_str()->check(CLI::Range(1, 1 << 20));
@@ -34,21 +38,42 @@ int main(int argc, char** argv) {
   app.add_option("--max-rollouts", opt.max_rollouts, "stop after this many rollouts (default: until signalled)");
   app.add_option("--threads", opt.threads, "OpenMP threads over environments")->capture_default_str()
       ->check(CLI::Range(1, 1 << 20));
+  app.add_option("--await-params-s", opt.await_params_s,
+                 "after each rollout, wait up to this long for newer parameters (0: never; keeps data on-policy)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_flag("--start-without-learner", opt.start_without_learner,
                "act with own initial parameters (version 0) instead of waiting for the learner");
+  app.add_option("--first-rollout-seq", opt.first_rollout_seq,
+                 "rollout_seq of the first rollout (default: the wall clock in microseconds, so a restarted "
+                 "actor's rollouts are told apart from its previous process's)")
+      ->check(CLI::NonNegativeNumber);
+  // Fault injection for tests of the learner's loss handling; never for training.
+  app.add_option("--drop-chunks-percent", opt.drop_chunks_percent,
+                 "FAULT INJECTION (tests only): throw away this percentage of rollout chunks instead of sending them")
+      ->check(CLI::Range(0.0, 100.0))->group("Fault injection");
+  app.add_option("--drop-seed", opt.drop_seed, "seed of the generator that picks the chunks to throw away")
+      ->capture_default_str()->group("Fault injection");
   CLI11_PARSE(app, argc, argv);
 
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   opt.stop = &g_stop;
   try {
-    const auto rc = masa::config::loadRunConfig(configs, overrides);
+    const auto rc = masa::config::loadRunConfig(configs, overrides, run_config);
     masa::actor::Actor actor(rc, opt);
     std::fprintf(stderr, "masa_actor %d: task %s, %d envs, horizon %d, run %lld; %s\n", opt.actor_id,
                  rc.task.c_str(), opt.num_envs, rc.ppo.horizon, static_cast<long long>(opt.run_id),
                  opt.start_without_learner ? "starting with own parameters" : "waiting for parameters");
+    if (opt.drop_chunks_percent > 0)
+      std::fprintf(stderr, "masa_actor %d: FAULT INJECTION: throwing away %g%% of rollout chunks (seed %llu)\n",
+                   opt.actor_id, opt.drop_chunks_percent, static_cast<unsigned long long>(opt.drop_seed));
     const auto sent = actor.run();
-    std::fprintf(stderr, "masa_actor %d: stopped after %lld rollouts\n", opt.actor_id, static_cast<long long>(sent));
+    std::fprintf(stderr, "masa_actor %d: stopped after %lld rollouts (numbered from %lld), %lld chunks sent", opt.actor_id,
+                 static_cast<long long>(sent), static_cast<long long>(actor.firstRolloutSeq()),
+                 static_cast<long long>(actor.chunksPublished()));
+    if (opt.drop_chunks_percent > 0)
+      std::fprintf(stderr, ", %lld thrown away by fault injection", static_cast<long long>(actor.chunksDropped()));
+    std::fprintf(stderr, "\n");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_actor: %s\n", e.what());
     return 2;

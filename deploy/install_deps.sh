@@ -14,8 +14,10 @@ packages=(
   # transport, tools and Java bindings (lcm-spy needs a JDK to build the types jar, and jchart2d)
   # (liblcm-dev needs glib headers but does not pull them in)
   liblcm-dev libglib2.0-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks (iproute2 and nftables: the multi-host tests over network namespaces)
+  libgtest-dev libgmock-dev libbenchmark-dev iproute2 nftables
+  # actors on other machines (deploy/train.sh --hosts)
+  openssh-client
   # offscreen rendering of rollouts
   libglfw3-dev xvfb xauth ffmpeg libpng-dev
   # the run directory's learning_curve.png

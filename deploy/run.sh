@@ -5,9 +5,9 @@
 # Before training it proves the task's symmetry spec against the physics (masa_verify).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-task=${1:-humanoid_tightrope}
-method=${2:-masa}
-shift $(( $# < 2 ? $# : 2 ))
+task=a1_beam method=masa
+[ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; shift; }
+[ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; shift; }
 bash deploy/build.sh
 ./build/tools/masa_verify --task "$task" --top 3
 exec bash deploy/train.sh "$task" "$method" "$@"

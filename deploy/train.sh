@@ -1,24 +1,37 @@
 #!/usr/bin/env bash
-# Trains on this machine: one learner and K actor processes over loopback LCM (udpm, ttl=0).
-# Ctrl-C stops everything cleanly; the learner checkpoints, so the run directory is resumable.
+# Trains with one learner on this machine and K actor processes, either on this machine over
+# loopback LCM (udpm, ttl=0), or, with --hosts FILE, on the hosts FILE lists, started there over ssh
+# and talking over LAN multicast (udpm, ttl=1). Ctrl-C stops everything cleanly, remote actors
+# included; the learner checkpoints, so the run directory is resumable.
 #   deploy/train.sh [task] [method] [--actors K] [--envs E] [--updates N] [--set key=value ...]
+#   deploy/train.sh [task] [method] --hosts FILE [--envs E] [--updates N] [--set key=value ...]
+#   deploy/train.sh --resume RUN_DIR [--actors K] [--envs E] [--updates N]   (N counts all updates)
+# FILE has one host per line, "host [actors] [envs]" (default 1 actor of E environments), '#'
+# comments; "localhost" runs its actors here without ssh. See deploy/hosts.example.
 # MASA_BUILD_DIR (default build) and MASA_RUNS_DIR (default runs) choose the folders, MASA_LCM_URL
-# the LCM URL (default: loopback multicast with the largest receive buffer the kernel allows).
+# the LCM URL (default: multicast with the largest receive buffer the kernel allows). With --hosts:
+#   MASA_REMOTE_SHELL      how to run a command on a host (default "ssh -o BatchMode=yes"); it is
+#                          called as `$MASA_REMOTE_SHELL HOST 'shell command'`, with the launcher's
+#                          keep-alive pipe on stdin (see deploy/tethered.sh)
+#   MASA_REMOTE_DIR        this repository's path on the hosts (default: the same as here)
+#   MASA_REMOTE_BUILD_DIR  the build folder there, relative to MASA_REMOTE_DIR (default MASA_BUILD_DIR)
 # Defaults are sized for a 2-core machine (the paper's 4096 x 32 batches are GPU-scale):
 # 2 actors x 32 environments, horizon 32, minibatch 1024. Override anything with --set.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-task=${1:-humanoid_tightrope}
-method=${2:-masa}
-shift $(( $# < 2 ? $# : 2 ))
-actors=2 envs=32 updates=200
+task=a1_beam method=masa
+[ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; shift; }
+[ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; shift; }
+actors=2 envs=32 updates=200 hosts_file="" actors_given=0 resume=""
 sets=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    --actors) actors=$2; shift 2 ;;
+    --resume) resume=$2; shift 2 ;;
+    --actors) actors=$2; actors_given=1; shift 2 ;;
     --envs) envs=$2; shift 2 ;;
     --updates) updates=$2; shift 2 ;;
+    --hosts) hosts_file=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
     *) echo "train.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -29,36 +42,174 @@ for bin in "$build/learner/masa_learner" "$build/actors/masa_actor"; do
   [ -x "$bin" ] || { echo "train.sh: $bin is missing: run deploy/build.sh first" >&2; exit 2; }
 done
 
-# Ask for the receive buffer the kernel allows (LCM drops large messages with a small one).
-rmem=$(cat /proc/sys/net/core/rmem_max 2>/dev/null || echo 2097152)
-buf=$(( rmem < 8388608 ? rmem : 8388608 ))
-url=${MASA_LCM_URL:-"udpm://239.255.76.67:7667?ttl=0&recv_buf_size=$buf"}
-run_id=$(( ($(date +%s%N) / 1000) % 2000000000 + 1 ))
-run_dir="${MASA_RUNS_DIR:-runs}/${task}_${method}_$(date +%Y%m%d_%H%M%S)"
-mkdir -p "$run_dir"
-
-common=(--set task="$task" --set method="$method" --set ppo.num_envs=$((actors * envs))
-        --set ppo.horizon=32 --set ppo.minibatch_size=1024 "${sets[@]}")
-
-echo "train.sh: $task / $method, $actors actors x $envs envs, $updates updates, run dir $run_dir"
-"$build/learner/masa_learner" "${common[@]}" --url "$url" --run-id "$run_id" --run-dir "$run_dir" \
-  --max-updates "$updates" &
-learner=$!
-pids=()
-for ((a = 0; a < actors; ++a)); do
-  OMP_NUM_THREADS=1 "$build/actors/masa_actor" "${common[@]}" --url "$url" --run-id "$run_id" --actor-id "$a" \
-    --num-envs "$envs" > "$run_dir/actor$a.log" 2>&1 &
-  pids+=($!)
+# Actor placement: host, actor count and environments per actor, one entry per hosts-file line.
+hosts=() host_actors=() host_envs=()
+if [ -n "$hosts_file" ]; then
+  [ "$actors_given" = 0 ] || { echo "train.sh: --actors and --hosts exclude each other (the hosts file gives the actors)" >&2; exit 2; }
+  [ -r "$hosts_file" ] || { echo "train.sh: cannot read hosts file '$hosts_file'" >&2; exit 2; }
+  line_no=0
+  while IFS= read -r line || [ -n "$line" ]; do
+    line_no=$((line_no + 1))
+    line=${line%%#*}
+    read -r h n e extra <<< "$line" || true
+    [ -n "${h:-}" ] || continue
+    n=${n:-1} e=${e:-$envs}
+    if [ -n "${extra:-}" ] || ! [[ "$n" =~ ^[1-9][0-9]*$ && "$e" =~ ^[1-9][0-9]*$ ]]; then
+      echo "train.sh: $hosts_file:$line_no: expected 'host [actors] [envs]' with positive counts, got '$line'" >&2
+      exit 2
+    fi
+    hosts+=("$h") host_actors+=("$n") host_envs+=("$e")
+  done < "$hosts_file"
+  [ ${#hosts[@]} -gt 0 ] || { echo "train.sh: $hosts_file lists no host" >&2; exit 2; }
+else
+  hosts=(localhost) host_actors=("$actors") host_envs=("$envs")
+fi
+actors=0 total_envs=0
+for i in "${!hosts[@]}"; do
+  actors=$((actors + host_actors[i]))
+  total_envs=$((total_envs + host_actors[i] * host_envs[i]))
 done
 
-stop() {
-  kill -INT "$learner" 2>/dev/null || true
-  wait "$learner" 2>/dev/null || true
+# Ask for the receive buffer the kernel allows (LCM drops large messages with a small one).
+# ttl=0 keeps the traffic on this machine; ttl=1 lets it cross one LAN segment to the hosts.
+rmem=$(cat /proc/sys/net/core/rmem_max 2>/dev/null || echo 2097152)
+buf=$(( rmem < 8388608 ? rmem : 8388608 ))
+ttl=$([ -n "$hosts_file" ] && echo 1 || echo 0)
+url=${MASA_LCM_URL:-"udpm://239.255.76.67:7667?ttl=$ttl&recv_buf_size=$buf"}
+if [ -n "$resume" ]; then
+  # The run goes on with its own config.yaml and run id; --set still overrides (e.g. a longer run).
+  [ -z "$hosts_file" ] || { echo "train.sh: --resume is for runs on this machine (start masa_learner --resume by hand with --hosts)" >&2; exit 2; }
+  for f in checkpoint.bin config.yaml run_id; do
+    [ -r "$resume/$f" ] || { echo "train.sh: $resume/$f is missing: not a run directory of train.sh" >&2; exit 2; }
+  done
+  run_dir=$resume run_id=$(cat "$resume/run_id")
+  learner_run=(--resume "$run_dir")
+  actor_config=(--run-config "$run_dir/config.yaml")
+  common=("${sets[@]+"${sets[@]}"}")
+  task=$(sed -n 's/^task: //p' "$run_dir/config.yaml") method=$(sed -n 's/^method: //p' "$run_dir/config.yaml")
+else
+  run_id=$(( ($(date +%s%N) / 1000) % 2000000000 + 1 ))
+  run_dir="${MASA_RUNS_DIR:-runs}/${task}_${method}_$(date +%Y%m%d_%H%M%S)"
+  mkdir -p "$run_dir"
+  echo "$run_id" > "$run_dir/run_id"
+  learner_run=(--run-dir "$run_dir")
+  actor_config=()
+  # Sized for a 2-core machine; the paper's batches (4096 envs x 32 steps, minibatch 32768) are GPU-scale.
+  common=(--set task="$task" --set method="$method" --set "ppo.num_envs=$total_envs"
+          --set ppo.horizon=32 --set ppo.minibatch_size=1024 "${sets[@]+"${sets[@]}"}")
+fi
+
+if [ -z "$hosts_file" ]; then
+  echo "train.sh: $task / $method, $actors actors x $envs envs, $updates updates, run dir $run_dir"
+  "$build/learner/masa_learner" "${common[@]+"${common[@]}"}" --url "$url" --run-id "$run_id" "${learner_run[@]}" \
+    --max-updates "$updates" &
+  learner=$!
+  pids=()
+  for ((a = 0; a < actors; ++a)); do
+    OMP_NUM_THREADS=1 "$build/actors/masa_actor" "${actor_config[@]+"${actor_config[@]}"}" "${common[@]+"${common[@]}"}" \
+      --url "$url" --run-id "$run_id" --actor-id "$a" --num-envs "$envs" >> "$run_dir/actor$a.log" 2>&1 &
+    pids+=($!)
+  done
+
+  stop() {
+    kill -INT "$learner" 2>/dev/null || true
+    wait "$learner" 2>/dev/null || true
+    kill -TERM "${pids[@]}" 2>/dev/null || true
+    wait "${pids[@]}" 2>/dev/null || true
+  }
+  trap 'echo "train.sh: stopping"; stop; exit 130' INT TERM
+  wait "$learner" || true
+  kill -TERM "${pids[@]}" 2>/dev/null || true
+  wait "${pids[@]}" 2>/dev/null || true
+  echo "train.sh: done. Curves: $run_dir/learning_curve.png, metrics: $run_dir/metrics.csv."
+  echo "train.sh: to go on to N updates in total: deploy/train.sh --resume $run_dir --actors $actors --envs $envs --updates N"
+  exit 0
+fi
+
+# --- Multi-host form ---
+read -r -a remote_shell <<< "${MASA_REMOTE_SHELL:-ssh -o BatchMode=yes}"
+remote_dir=${MASA_REMOTE_DIR:-$PWD}
+remote_build=${MASA_REMOTE_BUILD_DIR:-$build}
+
+# Keep-alive pipe: every actor's and the learner's tethered.sh reads it on stdin, and only this
+# script holds its write end (children close it), so when this script ends in any way, even by
+# SIGKILL, each of them sees end of file and stops its program: nothing is left running, here or
+# on the hosts. The fifo's name is removed at once; the open ends remain.
+fifo_dir=$(mktemp -d)
+mkfifo "$fifo_dir/keepalive"
+exec {keep}<>"$fifo_dir/keepalive"
+exec {alive_in}<"$fifo_dir/keepalive"
+rm -rf "$fifo_dir"
+
+echo "train.sh: $task / $method over $url, $actors actors on ${#hosts[@]} hosts ($total_envs envs), $updates updates, run dir $run_dir"
+# The learner may be in an update when told to stop: give it time to finish and checkpoint.
+MASA_TETHER_GRACE_S=300 bash deploy/tethered.sh "$build/learner/masa_learner" "${common[@]}" --url "$url" \
+  --run-id "$run_id" --run-dir "$run_dir" --max-updates "$updates" <&"$alive_in" {keep}>&- {alive_in}<&- &
+learner=$!
+pids=() pid_actor=()
+a=0
+for i in "${!hosts[@]}"; do
+  h=${hosts[i]}
+  for ((k = 0; k < host_actors[i]; ++k)); do
+    # localhost: this repository and build; another host: MASA_REMOTE_DIR and MASA_REMOTE_BUILD_DIR there.
+    dir=$remote_dir bin_dir=$remote_build
+    [ "$h" = localhost ] && dir=$PWD bin_dir=$build
+    actor_cmd=("$bin_dir/actors/masa_actor" "${common[@]}" --url "$url" --run-id "$run_id" --actor-id "$a"
+               --num-envs "${host_envs[i]}")
+    cmd="cd $(printf %q "$dir") && exec env OMP_NUM_THREADS=1 bash deploy/tethered.sh $(printf '%q ' "${actor_cmd[@]}")"
+    log="$run_dir/actor$a.log"
+    echo "# actor $a on $h, ${host_envs[i]} envs" > "$log"
+    echo "train.sh: actor $a on $h (${host_envs[i]} envs), log $log"
+    if [ "$h" = localhost ]; then
+      bash -c "$cmd" <&"$alive_in" >> "$log" 2>&1 {keep}>&- {alive_in}<&- &
+    else
+      "${remote_shell[@]}" "$h" "$cmd" <&"$alive_in" >> "$log" 2>&1 {keep}>&- {alive_in}<&- &
+    fi
+    pids+=($!) pid_actor+=("$a")
+    a=$((a + 1))
+  done
+done
+exec {alive_in}<&-
+
+# Closes the keep-alive pipe and gives the remote actors time to stop, then ends their shells.
+stop_actors() {
+  exec {keep}>&- 2>/dev/null || true
+  local t
+  for ((t = 0; t < 150; ++t)); do
+    local alive=0 p
+    for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+    [ "$alive" = 0 ] && break
+    sleep 0.1
+  done
   kill -TERM "${pids[@]}" 2>/dev/null || true
   wait "${pids[@]}" 2>/dev/null || true
 }
+stop() {
+  # SIGTERM: the tethered learner's wrapper, started in the background, cannot trap SIGINT.
+  kill -TERM "$learner" 2>/dev/null || true
+  wait "$learner" 2>/dev/null || true
+  stop_actors
+}
 trap 'echo "train.sh: stopping"; stop; exit 130' INT TERM
-wait "$learner" || true
-kill -TERM "${pids[@]}" 2>/dev/null || true
-wait "${pids[@]}" 2>/dev/null || true
+
+# Training goes on when an actor dies (the learner takes whoever is alive); say so, and where its log is.
+running=("${pids[@]}")
+while kill -0 "$learner" 2>/dev/null; do
+  ended=""
+  set +e
+  wait -n -p ended "$learner" "${running[@]}"
+  status=$?
+  set -e
+  [ -z "$ended" ] || [ "$ended" = "$learner" ] && break
+  still=()
+  for j in "${!pids[@]}"; do
+    if [ "${pids[j]}" = "$ended" ]; then
+      echo "train.sh: actor ${pid_actor[j]} ended (status $status) while training; see $run_dir/actor${pid_actor[j]}.log" >&2
+    fi
+  done
+  for p in "${running[@]}"; do [ "$p" = "$ended" ] || still+=("$p"); done
+  running=("${still[@]}")
+done
+wait "$learner" 2>/dev/null || true
+stop_actors
 echo "train.sh: done. Metrics: $run_dir/metrics.csv. Resume: $build/learner/masa_learner --resume $run_dir (with the same --set options)"

@@ -11,7 +11,11 @@ namespace masa::task {
 
 Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::SymmetrySpec spec, EnvParams& params,
            const std::vector<std::pair<std::string, double>>& terms_with_default_weights)
-    : model_(std::move(model)), name_(std::move(name)), spec_(std::move(spec)) {
+    : model_(std::move(model)),
+      name_(std::move(name)),
+      spec_(std::move(spec)),
+      obs_dim_(spec_.obsDim()),
+      act_dim_(spec_.actDim()) {
   frame_skip_ = params.integer("frame_skip", 5, 1);
   max_episode_steps_ = params.integer("max_episode_steps", 1000, 1);
   termination_reward_ = params.number("termination_reward", -1.0);

@@ -46,8 +46,9 @@ class Task {
   Task& operator=(const Task&) = delete;
 
   const std::string& name() const { return name_; }
-  int obsDim() const { return spec_.obsDim(); }
-  int actDim() const { return spec_.actDim(); }
+  // Cached: SymmetrySpec recomputes them from its layout, and step() asks several times per step.
+  int obsDim() const { return obs_dim_; }
+  int actDim() const { return act_dim_; }
   const sym::SymmetrySpec& spec() const { return spec_; }
   double controlTimestep() const;  // seconds per step(): frame_skip * model timestep
   int maxEpisodeSteps() const { return max_episode_steps_; }
@@ -123,6 +124,7 @@ class Task {
 
   std::string name_;
   sym::SymmetrySpec spec_;
+  int obs_dim_, act_dim_;
   int frame_skip_;
   int max_episode_steps_;
   double termination_reward_;

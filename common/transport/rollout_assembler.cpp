@@ -1,5 +1,7 @@
 #include "common/transport/rollout_assembler.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cstring>
 #include <iostream>
 #include <new>
@@ -64,6 +66,9 @@ RolloutAssembler::RolloutAssembler(const AssemblerConfig& config) : cfg_(config)
   MASA_CHECK(cfg_.max_policy_lag >= 0, "max_policy_lag must be >= 0");
   MASA_CHECK(cfg_.dedup_window >= 1 && cfg_.max_actors >= 1 && cfg_.max_envs_per_actor >= 1,
              "assembler limits must be positive");
+  MASA_CHECK(cfg_.loss_horizon >= 1 && cfg_.loss_horizon <= cfg_.dedup_window,
+             "loss_horizon must be in [1, dedup_window]");
+  MASA_CHECK(cfg_.max_rollout_gap >= 2 * cfg_.dedup_window, "max_rollout_gap must be at least 2 * dedup_window");
 }
 
 DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
@@ -127,41 +132,115 @@ DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
   return DropReason::kAccepted;
 }
 
-DropReason RolloutAssembler::markSeen(const masa::lcmt_rollout_chunk& m) {
+const ActorTally& RolloutAssembler::actorTally(int actor_id) const {
+  static const ActorTally kNone;
+  if (actor_id < 0 || actor_id >= static_cast<int>(actors_.size())) return kNone;
+  return actors_[actor_id].tally;
+}
+
+void RolloutAssembler::closeRollouts(ActorWindow& a, int actor_id, int64_t upto) {
+  int64_t lost = 0;
+  for (int64_t x = std::max(a.closed + 1, a.first); x <= upto; ++x) {
+    const SeenRollout* seen = nullptr;
+    for (const SeenRollout& r : a.rollouts)
+      if (r.seq == x) seen = &r;
+    if (seen == nullptr) {
+      lost += a.num_chunks;  // wholly lost: as many chunks as the actor's last rollout had
+      continue;
+    }
+    int arrived = 0;
+    for (std::size_t i = 0; i < seen->bits.size(); ++i) arrived += std::popcount(seen->bits[i] | seen->arrived[i]);
+    lost += seen->num_chunks - arrived;
+  }
+  a.closed = std::max(a.closed, upto);
+  if (lost == 0) return;
+  a.tally.lost += lost;
+  const int r = static_cast<int>(DropReason::kLost);
+  stats_.count[r] += lost;
+  if (warnDue(DropReason::kLost)) {
+    std::cerr << "masa transport: " << lost << " rollout chunk(s) from actor " << actor_id
+              << " never arrived (network loss, or a receive buffer too small: check net.core.rmem_max)";
+    if (suppressed_[r] > 0) std::cerr << "; " << suppressed_[r] << " more such reports not shown";
+    std::cerr << "; total lost " << stats_.count[r] << "\n";
+    suppressed_[r] = 0;
+  }
+}
+
+void RolloutAssembler::startNumbering(ActorWindow& a, int actor_id, int64_t seq) {
+  const bool restart = a.first >= 0;
+  if (restart) closeRollouts(a, actor_id, a.newest);  // the old numbering's last rollouts are final now
+  if (cfg_.warn_interval_s >= 0) {
+    if (restart) {
+      std::cerr << "masa transport: actor " << actor_id << " restarted (rollout numbering jumped from " << a.newest
+                << " to " << seq << "): a new numbering, not replays\n";
+    } else {
+      std::cerr << "masa transport: actor " << actor_id << " joined\n";
+    }
+  }
+  for (SeenRollout& r : a.rollouts) r.seq = -1;
+  a.first = a.newest = seq;
+  a.closed = seq - 1;
+  ++a.tally.numberings;
+}
+
+DropReason RolloutAssembler::markSeen(const masa::lcmt_rollout_chunk& m, bool accepted) {
   if (static_cast<int>(actors_.size()) <= m.actor_id) actors_.resize(m.actor_id + 1);
-  std::vector<SeenRollout>& window = actors_[m.actor_id].rollouts;
-  if (window.empty()) window.resize(cfg_.dedup_window);
+  ActorWindow& a = actors_[m.actor_id];
+  if (a.rollouts.empty()) a.rollouts.resize(cfg_.dedup_window);
+  const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
 
   SeenRollout* slot = nullptr;
-  SeenRollout* oldest = &window[0];
-  int64_t newest_seq = -1;
-  bool full = true;
-  for (SeenRollout& r : window) {
-    if (r.seq == m.rollout_seq) slot = &r;
-    if (r.seq < 0) full = false;
-    if (r.seq < oldest->seq) oldest = &r;
-    newest_seq = std::max(newest_seq, r.seq);
-  }
+  for (SeenRollout& r : a.rollouts)
+    if (r.seq == s) slot = &r;
   if (slot == nullptr) {
-    if (full && m.rollout_seq < oldest->seq) {
-      // Far behind everything remembered: an actor that restarted its count (accept and start
-      // over); merely behind the window: a replay or a straggler we can no longer check.
-      if (m.rollout_seq + 2 * int64_t{cfg_.dedup_window} >= newest_seq) return DropReason::kDuplicate;
-      for (SeenRollout& r : window) r.seq = -1;
-      oldest = &window[0];
+    if (a.first < 0 || s > a.newest + cfg_.max_rollout_gap || s + 2 * w < a.newest) {
+      // First sight, or a jump no live numbering makes: an actor restarted with the same id.
+      startNumbering(a, m.actor_id, s);
+    } else if (s <= a.newest - w) {
+      return DropReason::kDuplicate;  // behind the window: a replay or a straggler we can no longer check
+    } else if (s > a.newest) {
+      closeRollouts(a, m.actor_id, s - cfg_.loss_horizon);
+      a.newest = s;
     }
+    // At most w - 1 other slots hold rollouts within w of the newest, so the oldest slot is
+    // outside the window (its losses already counted) or unused.
+    SeenRollout* oldest = &a.rollouts[0];
+    for (SeenRollout& r : a.rollouts)
+      if (r.seq < oldest->seq) oldest = &r;
     slot = oldest;
-    slot->seq = m.rollout_seq;
+    slot->seq = s;
     slot->num_chunks = m.num_chunks;
     slot->bits.assign((m.num_chunks + 63) / 64, 0);
+    slot->arrived.assign(slot->bits.size(), 0);
   } else if (slot->num_chunks != m.num_chunks) {
     return DropReason::kOutOfRange;  // chunks of one rollout disagree on how many there are
   }
-  uint64_t& word = slot->bits[m.chunk_index / 64];
+  const std::size_t w64 = m.chunk_index / 64;
   const uint64_t bit = uint64_t{1} << (m.chunk_index % 64);
-  if (word & bit) return DropReason::kDuplicate;
-  word |= bit;
+  if (slot->bits[w64] & bit) return DropReason::kDuplicate;
+  const bool first_arrival = !(slot->arrived[w64] & bit);
+  (accepted ? slot->bits : slot->arrived)[w64] |= bit;
+  a.num_chunks = m.num_chunks;
+  if (accepted) ++a.tally.accepted;
+  if (first_arrival && s <= a.closed && a.tally.lost > 0) {
+    // Arrived after its rollout's losses were counted: it was not lost after all.
+    --a.tally.lost;
+    --stats_.count[static_cast<int>(DropReason::kLost)];
+  }
   return DropReason::kAccepted;
+}
+
+bool RolloutAssembler::warnDue(DropReason reason) {
+  if (cfg_.warn_interval_s < 0) return false;
+  const int r = static_cast<int>(reason);
+  const auto now = std::chrono::steady_clock::now();
+  if (warned_[r] && std::chrono::duration<double>(now - last_warn_[r]).count() < cfg_.warn_interval_s) {
+    ++suppressed_[r];
+    return false;
+  }
+  warned_[r] = true;
+  last_warn_[r] = now;
+  return true;
 }
 
 Verdict RolloutAssembler::finish(DropReason reason, const masa::lcmt_rollout_chunk* m) {
@@ -173,29 +252,28 @@ Verdict RolloutAssembler::finish(DropReason reason, const masa::lcmt_rollout_chu
     return v;
   }
   const int r = static_cast<int>(reason);
-  if (cfg_.warn_interval_s >= 0) {
-    const auto now = std::chrono::steady_clock::now();
-    if (!warned_[r] || std::chrono::duration<double>(now - last_warn_[r]).count() >= cfg_.warn_interval_s) {
-      std::cerr << "masa transport: dropped rollout chunk (" << dropReasonName(reason) << ")";
-      if (m != nullptr) {
-        std::cerr << " from actor " << m->actor_id << " rollout " << m->rollout_seq << " chunk " << m->chunk_index
-                  << " version " << m->policy_version << " (learner at " << version_ << ")";
-      }
-      if (suppressed_[r] > 0) std::cerr << "; " << suppressed_[r] << " more for this reason not shown";
-      std::cerr << "; total " << stats_.count[r] << "\n";
-      warned_[r] = true;
-      last_warn_[r] = now;
-      suppressed_[r] = 0;
-    } else {
-      ++suppressed_[r];
+  if (warnDue(reason)) {
+    std::cerr << "masa transport: dropped rollout chunk (" << dropReasonName(reason) << ")";
+    if (m != nullptr) {
+      std::cerr << " from actor " << m->actor_id << " rollout " << m->rollout_seq << " chunk " << m->chunk_index
+                << " version " << m->policy_version << " (learner at " << version_ << ")";
     }
+    if (suppressed_[r] > 0) std::cerr << "; " << suppressed_[r] << " more for this reason not shown";
+    std::cerr << "; total " << stats_.count[r] << "\n";
+    suppressed_[r] = 0;
   }
   return v;
 }
 
 Verdict RolloutAssembler::accept(const masa::lcmt_rollout_chunk& msg) {
   DropReason reason = validate(msg);
-  if (reason == DropReason::kAccepted) reason = markSeen(msg);  // only valid chunks mark as seen
+  if (reason == DropReason::kAccepted) {
+    reason = markSeen(msg, /*accepted=*/true);
+  } else if (reason == DropReason::kTooOld || reason == DropReason::kFutureVersion) {
+    // Well-formed (the version is checked after the sizes and ranges) and merely out of date: it
+    // arrived, so it must not be counted lost. Hostile chunks never mark anything as seen.
+    markSeen(msg, /*accepted=*/false);
+  }
   return finish(reason, &msg);
 }
 

@@ -6,6 +6,14 @@
 // a rate-limited warning on stderr. An accepted chunk is usable on its own: chunks hold whole
 // environments, so a rollout whose other chunks were lost still delivers the environments that
 // arrived, and nothing ever waits for a missing chunk.
+//
+// Per actor it follows the rollout numbering (rollout_seq): duplicates are detected within the last
+// dedup_window rollouts, and chunks that never arrived are counted as kLost once the actor is
+// loss_horizon rollouts past their rollout (a wholly lost rollout counts as many chunks as the
+// actor's last rollout had). A jump ahead of more than max_rollout_gap rollouts, or back by more than
+// 2 * dedup_window, starts a new numbering: an actor restarted with the same id (masa_actor numbers
+// from its start time in microseconds, so a restart jumps millions ahead) is accepted at once, not
+// taken for a replay.
 #pragma once
 
 #include <chrono>
@@ -28,6 +36,8 @@ struct AssemblerConfig {
   int max_envs_per_actor = 1 << 16;  // env_offset + num_envs must not exceed
   int max_terms = 256;               // num_terms must not exceed
   int dedup_window = 16;             // rollouts per actor remembered to detect duplicates
+  int loss_horizon = 2;              // rollouts an actor must be past a rollout before its gaps count as lost
+  int max_rollout_gap = 4096;        // a longer jump ahead is a new numbering, a shorter one lost rollouts
   double warn_interval_s = 5.0;      // at most one warning per reason per interval; < 0: silent
 };
 
@@ -51,6 +61,13 @@ struct Verdict {
   explicit operator bool() const { return chunk.has_value(); }
 };
 
+// What arrived from one actor id, over all its processes.
+struct ActorTally {
+  int64_t accepted = 0;    // chunks accepted
+  int64_t lost = 0;        // chunks that never arrived (a chunk arriving after it was counted is taken off)
+  int64_t numberings = 0;  // rollout numberings seen: 1 + restarts
+};
+
 class RolloutAssembler {
  public:
   explicit RolloutAssembler(const AssemblerConfig& config);
@@ -68,20 +85,36 @@ class RolloutAssembler {
 
   const DropStats& stats() const { return stats_; }
   const AssemblerConfig& config() const { return cfg_; }
+  // All zero for an actor id never seen.
+  const ActorTally& actorTally(int actor_id) const;
 
  private:
-  DropReason validate(const masa::lcmt_rollout_chunk& m) const;
-  DropReason markSeen(const masa::lcmt_rollout_chunk& m);
-  Verdict finish(DropReason reason, const masa::lcmt_rollout_chunk* m);
-
   struct SeenRollout {
     int64_t seq = -1;  // -1: slot unused
     int32_t num_chunks = 0;
-    std::vector<uint64_t> bits;  // one bit per chunk index
+    std::vector<uint64_t> bits;     // one bit per chunk index: accepted (duplicates are checked here)
+    std::vector<uint64_t> arrived;  // chunks that came but were out of date: not lost, not accepted
   };
   struct ActorWindow {
     std::vector<SeenRollout> rollouts;  // dedup_window slots, replaced oldest first
+    int64_t first = -1;                 // first rollout seen in the current numbering (-1: none yet)
+    int64_t newest = -1;                // newest rollout seen in it
+    int64_t closed = -1;                // rollouts up to this one have had their losses counted
+    int32_t num_chunks = 0;             // chunks per rollout, as last seen
+    ActorTally tally;
   };
+
+  DropReason validate(const masa::lcmt_rollout_chunk& m) const;
+  // Records the chunk's arrival for duplicate detection and loss counting. `accepted`: it passed
+  // validation, is checked for duplicates and counted in the actor's tally; otherwise it is only
+  // noted as arrived (so that no hostile copy can make the genuine chunk look like a duplicate).
+  // Returns kAccepted, kDuplicate or kOutOfRange.
+  DropReason markSeen(const masa::lcmt_rollout_chunk& m, bool accepted);
+  // Counts the missing chunks of rollouts (closed, upto] of the current numbering.
+  void closeRollouts(ActorWindow& a, int actor_id, int64_t upto);
+  void startNumbering(ActorWindow& a, int actor_id, int64_t seq);
+  Verdict finish(DropReason reason, const masa::lcmt_rollout_chunk* m);
+  bool warnDue(DropReason reason);
 
   AssemblerConfig cfg_;
   int64_t version_ = 0;

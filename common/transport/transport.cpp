@@ -26,32 +26,38 @@ Transport::Transport(const std::string& url) : url_(url) {
 }
 
 Transport::~Transport() {
-  for (Sub& s : subs_) lcm_->unsubscribe(s.lcm_sub);
+  for (Sub& s : subs_) lcm_unsubscribe(lcm_->getUnderlyingLCM(), s.lcm_sub);
 }
 
 bool Transport::publishRaw(const std::string& channel, const void* data, int size) {
   return lcm_->publish(channel, data, static_cast<unsigned int>(size)) == 0;
 }
 
-void Transport::dispatch(const void* rbuf, const std::string&, Sub* sub) {
-  const auto* rb = static_cast<const lcm::ReceiveBuffer*>(rbuf);
-  sub->handler(rb->data, static_cast<int>(rb->data_size));
-}
-
 Transport::SubscriptionId Transport::subscribeRaw(const std::string& channel, RawHandler handler) {
   Sub& s = subs_.emplace_back();
   s.id = next_id_++;
   s.handler = std::move(handler);
-  s.lcm_sub = lcm_->subscribeFunction<Sub*>(
-      channel,
-      [](const lcm::ReceiveBuffer* rb, const std::string& ch, Sub* sub) { dispatch(rb, ch, sub); }, &s);
+  // The C API, because lcm-cpp hides a failed subscribe behind a Subscription that never fires.
+  s.lcm_sub = lcm_subscribe(
+      lcm_->getUnderlyingLCM(), channel.c_str(),
+      [](const lcm_recv_buf_t* rb, const char*, void* user) {
+        static_cast<Sub*>(user)->handler(rb->data, static_cast<int>(rb->data_size));
+      },
+      &s);
+  if (s.lcm_sub == nullptr) {
+    subs_.pop_back();
+    throw std::runtime_error("masa transport: LCM cannot subscribe to " + channel + " on '" + url_ +
+                             "' (for udpm: its self test failed, its own multicast did not come back: check the "
+                             "multicast route and that no firewall drops it)");
+  }
+  lcm_subscription_set_queue_capacity(s.lcm_sub, kSubscriptionQueueCapacity);
   return s.id;
 }
 
 void Transport::unsubscribe(SubscriptionId id) {
   for (auto it = subs_.begin(); it != subs_.end(); ++it) {
     if (it->id == id) {
-      lcm_->unsubscribe(it->lcm_sub);
+      lcm_unsubscribe(lcm_->getUnderlyingLCM(), it->lcm_sub);
       subs_.erase(it);
       return;
     }

@@ -19,13 +19,18 @@
 
 namespace lcm {
 class LCM;
-class Subscription;
 }  // namespace lcm
+struct _lcm_subscription_t;
 
 namespace masa::transport {
 
 // Microseconds since the Unix epoch (the utime fields of the messages).
 int64_t wallClockMicros();
+
+// Messages LCM keeps queued per subscription between handle calls; past it, LCM drops them
+// silently. LCM's default, 30, lost rollout chunks whenever the learner was busy with an update
+// (about 15% of them in a 2-actor run on this machine); 2048 chunks of 60 KB are about 120 MB.
+inline constexpr int kSubscriptionQueueCapacity = 2048;
 
 class Transport {
  public:
@@ -49,7 +54,9 @@ class Transport {
   bool publishRaw(const std::string& channel, const void* data, int size);
 
   // Raw bytes, for input that must be bounds-checked before decoding (rollout chunks: see
-  // RolloutAssembler::acceptEncoded).
+  // RolloutAssembler::acceptEncoded). Throws std::runtime_error when LCM cannot subscribe (udpm:
+  // its self test failed, e.g. a firewall drops the process's own multicast), rather than
+  // leaving a subscription that never receives anything.
   SubscriptionId subscribeRaw(const std::string& channel, RawHandler handler);
   // Decoded messages. A message that fails to decode is counted (decodeErrors()) and skipped.
   template <class Msg>
@@ -67,9 +74,8 @@ class Transport {
   struct Sub {
     SubscriptionId id;
     RawHandler handler;
-    lcm::Subscription* lcm_sub = nullptr;
+    _lcm_subscription_t* lcm_sub = nullptr;  // LCM's C API: it reports a failed subscribe
   };
-  static void dispatch(const void* rbuf, const std::string& channel, Sub* sub);
 
   std::string url_;
   RecvBufCheck recv_buf_;

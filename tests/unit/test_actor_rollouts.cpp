@@ -2,11 +2,14 @@
 // chunks and heartbeats out.
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "actors/actor.hpp"
@@ -92,6 +95,8 @@ actor::ActorOptions options(int num_envs, int64_t max_rollouts) {
   o.max_rollouts = max_rollouts;
   o.threads = 2;
   o.chunk_bytes = 8000;  // small, so that a rollout is split into several chunks
+  o.first_rollout_seq = 0;  // bit-identical chunks from run to run
+  o.await_params_s = 0;     // no learner here to wait for
   return o;
 }
 
@@ -268,6 +273,67 @@ TEST(ActorRollouts, StartWithoutLearnerActsWithVersionZero) {
   EXPECT_EQ(decode(cap.chunks[0]).policy_version, 0);
 }
 
+TEST(ActorRollouts, ARestartedActorNumbersItsRolloutsPastItsPreviousProcessAndIsAccepted) {
+  const auto rc = smallConfig(7);
+  transport::Transport bus("memq://");
+  Capture cap(bus);
+  FakeLearner learner(rc, 5);
+  auto opt = options(2, 2);
+  opt.first_rollout_seq = actor::kRolloutSeqFromClock;  // what masa_actor does
+  int64_t first_seq[2];
+  for (int process = 0; process < 2; ++process) {  // the same actor id, twice: killed and restarted
+    actor::Actor actor(rc, opt, &bus);
+    first_seq[process] = actor.firstRolloutSeq();
+    bus.publish(transport::kPolicyChannel, learner.message(1));
+    EXPECT_EQ(actor.run(), 2);
+    bus.drain();
+  }
+  EXPECT_GT(first_seq[1], first_seq[0] + 2) << "the restart numbers past every rollout the first process sent";
+  transport::AssemblerConfig ac;
+  ac.run_id = kRunId;
+  ac.horizon = kHorizon;
+  ac.obs_dim = learner.spec.obsDim();
+  ac.act_dim = learner.spec.actDim();
+  ac.warn_interval_s = -1;
+  transport::RolloutAssembler assembler(ac);
+  assembler.setLearnerVersion(1);
+  for (const auto& bytes : cap.chunks) {
+    const auto v = assembler.acceptEncoded(bytes.data(), static_cast<int>(bytes.size()));
+    EXPECT_TRUE(v) << "dropped: " << transport::dropReasonName(v.reason);
+  }
+  EXPECT_EQ(assembler.actorTally(3).accepted, static_cast<int64_t>(cap.chunks.size()));
+  EXPECT_EQ(assembler.actorTally(3).numberings, 2);
+}
+
+TEST(ActorRollouts, FaultInjectionThrowsAwayTheRequestedShareOfChunksReproducibly) {
+  const auto rc = smallConfig(8, "a1_beam");
+  auto run = [&](uint64_t drop_seed) {
+    transport::Transport bus("memq://");
+    Capture cap(bus);
+    auto opt = options(6, 6);
+    opt.chunk_bytes = 1;  // one environment per chunk: 36 chunks
+    opt.start_without_learner = true;
+    opt.drop_chunks_percent = 40;
+    opt.drop_seed = drop_seed;
+    actor::Actor actor(rc, opt, &bus);
+    actor.run();
+    bus.drain();
+    EXPECT_EQ(actor.chunksPublished(), static_cast<int64_t>(cap.chunks.size()));
+    std::vector<int64_t> kept;
+    for (const auto& b : cap.chunks) {
+      const auto m = decode(b);
+      kept.push_back(m.rollout_seq * 1000 + m.chunk_index);
+    }
+    return std::make_pair(actor.chunksDropped(), kept);
+  };
+  const auto [dropped, kept] = run(3);
+  const double total = static_cast<double>(dropped + static_cast<int64_t>(kept.size()));
+  ASSERT_EQ(total, 36);
+  EXPECT_NEAR(dropped / total, 0.4, 0.2);
+  EXPECT_EQ(run(3).second, kept) << "the same seed throws away the same chunks";
+  EXPECT_NE(run(4).second, kept);
+}
+
 TEST(ActorRollouts, StopFlagEndsTheRunBetweenSteps) {
   const auto rc = smallConfig(6);
   transport::Transport bus("memq://");
@@ -281,6 +347,39 @@ TEST(ActorRollouts, StopFlagEndsTheRunBetweenSteps) {
   };
   actor::Actor actor(rc, opt, &bus);
   EXPECT_EQ(actor.run(), 1) << "the interrupted rollout is not sent";
+}
+
+// A fast actor waits (bounded) for the learner's next version instead of collecting rollouts the
+// learner would drop as stale; with no learner the wait expires and collection goes on.
+TEST(ActorRollouts, BetweenRolloutsTheActorWaitsBoundedForNewerParameters) {
+  const auto rc = smallConfig(8);
+  transport::Transport bus("memq://");
+  auto opt = options(2, 3);
+  opt.start_without_learner = true;
+  opt.await_params_s = 0.4;
+  actor::Actor actor(rc, opt, &bus);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(actor.run(), 3);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(elapsed, 0.8) << "two waits of 0.4 s between three rollouts (none after the last)";
+}
+
+TEST(ActorRollouts, NewerParametersEndTheWaitAtOnce) {
+  const auto rc = smallConfig(9);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  auto opt = options(2, 2);
+  opt.await_params_s = 30.0;  // a missed wake-up would show as a 30 s test
+  // Each rollout's chunk is answered with the next version, as a learner does after its update.
+  int64_t next = 1;
+  bus.subscribeRaw(transport::kRolloutChannel,
+                   [&](const void*, int) { bus.publish(transport::kPolicyChannel, learner.message(next++)); });
+  actor::Actor actor(rc, opt, &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(0));
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(actor.run(), 2);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 20.0);
+  EXPECT_GE(actor.policyVersion(), 1);
 }
 
 }  // namespace

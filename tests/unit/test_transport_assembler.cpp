@@ -212,6 +212,91 @@ TEST(RolloutAssembler, DuplicateChunkOfAnOlderRolloutIsDroppedButOtherActorsAreI
   EXPECT_EQ(assembler.accept(odd).reason, DropReason::kOutOfRange);
 }
 
+// masa_actor numbers rollouts from its start time in microseconds; a restart with the same actor id
+// therefore jumps far ahead of what its previous process sent.
+TEST(RolloutAssembler, RestartedActorIsAcceptedAtOnceAndItsJumpCountsAsANewNumbering) {
+  RolloutAssembler assembler(assemblerConfig());
+  const int64_t first_start = 1'700'000'000'000'000;  // microseconds since the epoch
+  int64_t sent = 0;
+  for (int64_t k = 0; k < 5; ++k)  // fewer rollouts than the dedup window remembers
+    for (const auto& c : makeChunks(0, first_start + k)) {
+      ASSERT_TRUE(assembler.accept(c));
+      ++sent;
+    }
+  // Killed, restarted 3 s later: every chunk of every rollout of the new process goes through.
+  const int64_t second_start = first_start + 3'000'000;
+  for (int64_t k = 0; k < 5; ++k)
+    for (const auto& c : makeChunks(0, second_start + k)) {
+      const Verdict v = assembler.accept(c);
+      EXPECT_TRUE(v) << "rollout " << k << " of the restarted actor: " << dropReasonName(v.reason);
+      ++sent;
+    }
+  EXPECT_EQ(assembler.stats()[DropReason::kAccepted], sent);
+  EXPECT_EQ(assembler.stats().dropped(), 0) << "nothing dropped, nothing counted lost";
+  EXPECT_EQ(assembler.actorTally(0).numberings, 2);
+  EXPECT_EQ(assembler.actorTally(0).accepted, sent);
+  // Duplicates are still caught within the new numbering.
+  EXPECT_EQ(assembler.accept(makeChunks(0, second_start + 4)[0]).reason, DropReason::kDuplicate);
+  // A clock stepped back by more than the window is a new numbering as well, not a replay.
+  for (const auto& c : makeChunks(0, first_start - 1'000'000)) EXPECT_TRUE(assembler.accept(c));
+  EXPECT_EQ(assembler.actorTally(0).numberings, 3);
+}
+
+TEST(RolloutAssembler, ARestartThatReusedItsNumberingWouldBeTakenForReplays) {
+  // Why masa_actor does not number from 0: a restarted process's first rollouts would collide
+  // with the dead one's, within the window, and be dropped as duplicates.
+  RolloutAssembler assembler(assemblerConfig());
+  for (int64_t k = 0; k < 5; ++k)
+    for (const auto& c : makeChunks(0, k)) ASSERT_TRUE(assembler.accept(c));
+  EXPECT_EQ(assembler.accept(makeChunks(0, 0)[0]).reason, DropReason::kDuplicate);
+}
+
+TEST(RolloutAssembler, ChunksThatNeverArriveAreCountedAsLostOnceTheActorIsTwoRolloutsPast) {
+  RolloutAssembler assembler(assemblerConfig());
+  ASSERT_EQ(assembler.config().loss_horizon, 2);
+  const int64_t base = 5000;
+  auto chunksOf = [&](int64_t k) { return makeChunks(0, base + k, /*actor=*/1); };
+  auto send = [&](int64_t k, int skip_chunk = -1) {
+    const auto chunks = chunksOf(k);
+    for (int i = 0; i < static_cast<int>(chunks.size()); ++i) {
+      if (i == skip_chunk) continue;
+      ASSERT_TRUE(assembler.accept(chunks[i]));
+    }
+  };
+  send(0, /*skip_chunk=*/1);
+  send(1);
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], 0) << "rollout 0 may still be completed by a late chunk";
+  // Rollout 2 never arrives at all.
+  send(3);
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], 1) << "rollout 0's chunk 1, once rollout 2 could have come";
+  send(4);
+  // A wholly lost rollout counts as many chunks as the actor's last rollout (3) had.
+  const int64_t lost = 1 + static_cast<int64_t>(chunksOf(3).size());
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], lost);
+  EXPECT_EQ(assembler.actorTally(1).lost, lost);
+  EXPECT_EQ(assembler.actorTally(0).lost, 0) << "other actors are untouched";
+  EXPECT_EQ(assembler.stats().dropped(), lost) << "lost chunks are part of the drop total";
+  // Rollouts 5 to 104 lost on the way (an outage): counted, not taken for a restart.
+  send(105);
+  send(106);
+  send(107);
+  EXPECT_EQ(assembler.actorTally(1).numberings, 1);
+  // 5..103 were counted when 105 came (estimated with rollout 4's chunk count), 104 when 106 came.
+  const int64_t after_outage = lost + 99 * static_cast<int64_t>(chunksOf(4).size()) + chunksOf(105).size();
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], after_outage);
+  EXPECT_EQ(assembler.accept(chunksOf(4)[0]).reason, DropReason::kDuplicate) << "behind the window";
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], after_outage);
+  // A chunk of rollout 2 turning up late is still used, and no longer counted lost.
+  // (Within the dedup window only; rollout 2 is far behind now, so go back to the state before.)
+  RolloutAssembler fresh(assemblerConfig());
+  for (int64_t k : {0, 1, 3, 4})
+    for (const auto& c : chunksOf(k)) ASSERT_TRUE(fresh.accept(c));
+  const int64_t lost_before = fresh.stats()[DropReason::kLost];
+  ASSERT_EQ(lost_before, static_cast<int64_t>(chunksOf(4).size()));  // rollout 2, estimated
+  ASSERT_TRUE(fresh.accept(chunksOf(2)[0]));
+  EXPECT_EQ(fresh.stats()[DropReason::kLost], lost_before - 1);
+}
+
 TEST(RolloutAssembler, MalformedBytesAreDroppedWithoutDecodingHostileLengths) {
   RolloutAssembler assembler(assemblerConfig());
   const auto chunks = makeChunks(0);

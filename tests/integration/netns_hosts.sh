@@ -1,0 +1,147 @@
+#!/usr/bin/env bash
+# The multi-host launcher (deploy/train.sh --hosts) on one machine: three network namespaces joined
+# by veth pairs and a bridge stand in for a learner host and two actor hosts, `ip netns exec` for
+# ssh (tests/integration/netns_shell.sh), LCM crosses them with ttl=1 like on a LAN.
+#   1. a bounded run (3 updates) completes with chunks accepted from both actor hosts, the actors'
+#      logs come back to the run dir, and no actor is left running on the hosts;
+#   2. Ctrl-C (SIGINT to the launcher's process group) and 3. SIGTERM to the launcher stop the
+#      learner (it checkpoints) and the remote actors;
+#   4. SIGKILL to the launcher still stops the remote actors and the learner (their keep-alive
+#      pipe closes: see deploy/tethered.sh).
+# With --drop P, instead: nftables on the learner's host drops P% of the inbound LCM datagrams at
+# random; training must not stall (4 updates), and the learner must count the lost chunks.
+#   MASA_BUILD_DIR=build bash tests/integration/netns_hosts.sh [--port PORT] [--drop PERCENT]
+# Needs root and `ip netns` (and nft for --drop); otherwise it prints SKIP and exits 77.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+source tests/integration/lib.sh
+
+port=7673 drop=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --port) port=$2; shift 2 ;;
+    --drop) drop=$2; shift 2 ;;
+    *) echo "netns_hosts.sh: unknown option '$1'" >&2; exit 2 ;;
+  esac
+done
+
+[[ "$drop" =~ ^[0-9]+$ ]] && [ "$drop" -le 99 ] || { echo "netns_hosts.sh: --drop takes 0 to 99 (percent)" >&2; exit 2; }
+
+skip() { echo "SKIP: $*"; exit 77; }
+[ "$(id -u)" = 0 ] || skip "making network namespaces needs root"
+command -v ip >/dev/null || skip "iproute2 ('ip') is not installed"
+ip netns list >/dev/null 2>&1 || skip "'ip netns' is not available"
+if [ "$drop" -gt 0 ]; then command -v nft >/dev/null || skip "nftables ('nft') is not installed"; fi
+require_binaries
+
+# Names unique to this run, so that parallel runs do not collide.
+ns_l="masa$$l" ns_a="masa$$a" ns_b="masa$$b" ns_br="masa$$br"
+work=$(mktemp -d "${TMPDIR:-/tmp}/masa_netns.XXXXXX")
+rmem=$(cat /proc/sys/net/core/rmem_max 2>/dev/null || echo 2097152)
+url="udpm://239.255.76.67:$port?ttl=1&recv_buf_size=$(( rmem < 8388608 ? rmem : 8388608 ))"
+
+cleanup() {
+  kill_started
+  local ns p
+  for ns in "$ns_l" "$ns_a" "$ns_b" "$ns_br"; do
+    # Whatever still runs in these namespaces was started by this test.
+    for p in $(ip netns pids "$ns" 2>/dev/null); do kill -KILL "$p" 2>/dev/null || true; done
+    ip netns del "$ns" 2>/dev/null || true
+  done
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+setup_network() {
+  ip netns add "$ns_br"
+  ip -n "$ns_br" link add br0 type bridge mcast_snooping 0  # no IGMP querier here: flood multicast
+  ip -n "$ns_br" link set br0 up
+  local i=1 ns
+  for ns in "$ns_l" "$ns_a" "$ns_b"; do
+    ip netns add "$ns"
+    ip -n "$ns" link add eth0 type veth peer name port$i netns "$ns_br"
+    ip -n "$ns" addr add "10.77.0.$i/24" dev eth0
+    ip -n "$ns" link set eth0 up
+    ip -n "$ns" link set lo up
+    ip -n "$ns" route add 224.0.0.0/4 dev eth0  # LCM's multicast group goes out on the "LAN"
+    ip -n "$ns_br" link set "port$i" master br0 up
+    i=$((i + 1))
+  done
+}
+if ! err=$(setup_network 2>&1); then skip "cannot build network namespaces here: $err"; fi
+log "namespaces: learner $ns_l, actor hosts $ns_a and $ns_b, bridge in $ns_br; $url (work dir $work)"
+
+printf '# actor hosts of this test\n%s 1 8\n%s   # one actor, --envs environments\n' "$ns_a" "$ns_b" > "$work/hosts"
+launcher=(ip netns exec "$ns_l" env MASA_BUILD_DIR="$build" MASA_LCM_URL="$url"
+          MASA_REMOTE_SHELL="bash $PWD/tests/integration/netns_shell.sh"
+          bash deploy/train.sh a1_beam masa --hosts "$work/hosts" --envs 8
+          --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.minibatch_size=256)
+
+no_actor_left() { [ -z "$(ip netns pids "$ns_a")$(ip netns pids "$ns_b")" ]; }
+run_dir_of() { ls -d "$1"/*/ 2>/dev/null | head -1; }
+
+if [ "$drop" -gt 0 ]; then
+  # Random loss of the LCM datagrams that reach the learner's host from the actor hosts (tc netem
+  # is not in this kernel). Its own multicast, looped back, is spared: LCM's start-up self test
+  # needs it.
+  ip netns exec "$ns_l" nft -f - <<EOF
+table inet masa_test {
+  chain input {
+    type filter hook input priority 0; policy accept;
+    ip saddr != 10.77.0.1 udp dport $port numgen random mod 100 < $drop counter drop
+  }
+}
+EOF
+  log "nftables on $ns_l drops $drop% of the UDP datagrams to port $port from the actor hosts"
+  MASA_RUNS_DIR="$work/runs" timeout 90 "${launcher[@]}" --updates 4 > "$work/launcher.log" 2>&1 ||
+    fail "the launcher did not finish 4 updates with $drop% loss (status $?)"
+  grep -q "stopped after 4 updates; checkpoint written" "$work/launcher.log" || fail "the learner did not finish 4 updates"
+  dropped=$(ip netns exec "$ns_l" nft list chain inet masa_test input | sed -n 's/.*counter packets \([0-9]*\).*/\1/p')
+  [ "${dropped:-0}" -gt 0 ] || fail "nftables dropped nothing: the fault was not injected"
+  lost=$(sed -n 's/^masa_learner: rollout chunks accepted.*, lost \([0-9][0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
+  [ -n "$lost" ] && [ "$lost" -gt 0 ] || fail "nftables dropped $dropped datagrams but the learner counted no lost chunk"
+  wait_until 15 "the remote actors to stop after the run" no_actor_left
+  echo "PASS: 4 updates over the namespace LAN with $drop% random loss; nftables dropped $dropped datagrams, the learner counted $lost lost chunks"
+  rm -rf "$work"
+  exit 0
+fi
+
+# 1. A bounded run.
+MASA_RUNS_DIR="$work/runs1" timeout 90 "${launcher[@]}" --updates 3 > "$work/launcher.log" 2>&1 ||
+  fail "the launcher failed or timed out (status $?)"
+grep -q "stopped after 3 updates; checkpoint written" "$work/launcher.log" || fail "the learner did not finish 3 updates"
+grep -q "actor 0 joined" "$work/launcher.log" || fail "no chunk from actor 0 (host $ns_a) was accepted"
+grep -q "actor 1 joined" "$work/launcher.log" || fail "no chunk from actor 1 (host $ns_b) was accepted"
+run=$(run_dir_of "$work/runs1")
+for a in 0 1; do
+  grep -q "masa_actor $a: stopped after" "$run/actor$a.log" ||
+    fail "actor $a's log in the run dir does not show it stopping cleanly"
+done
+wait_until 15 "the remote actors to be gone after the run" no_actor_left
+log "PASS part 1: 3 updates with chunks from both hosts; remote logs in $run; no actor left"
+
+# 2-4. The launcher stopped from outside while training: Ctrl-C (SIGINT to its whole process group,
+# as a terminal sends it), SIGTERM to the launcher alone, SIGKILL to the launcher alone.
+part=2
+for sig in INT TERM KILL; do
+  # Job control gives the launcher its own process group, and leaves SIGINT trappable in it.
+  [ "$sig" = INT ] && set -m
+  MASA_RUNS_DIR="$work/runs_$sig" "${launcher[@]}" --updates 100000 > "$work/launcher_$sig.log" 2>&1 &
+  pid=$!
+  set +m
+  started_pids+=("$pid")
+  wait_until 60 "2 updates before SIG$sig" eval '[ -n "$(run_dir_of "$work/runs_$sig")" ] && at_least_updates "$(run_dir_of "$work/runs_$sig")" 2'
+  if [ "$sig" = INT ]; then kill -INT -- "-$pid"; else kill -"$sig" "$pid"; fi
+  status=0
+  wait "$pid" 2>/dev/null || status=$?
+  wait_until 20 "the remote actors to stop after SIG$sig to the launcher" no_actor_left
+  wait_until 20 "the learner to stop after SIG$sig to the launcher" eval '[ -z "$(ip netns pids "$ns_l")" ]'
+  grep -q "checkpoint written" "$work/launcher_$sig.log" || fail "the learner did not checkpoint after SIG$sig"
+  if [ "$sig" != KILL ]; then
+    [ "$status" = 130 ] || fail "the launcher exited with $status after SIG$sig, expected 130"
+  fi
+  log "PASS part $part: SIG$sig to the launcher stopped the remote actors and the learner (checkpoint written)"
+  part=$((part + 1))
+done
+echo "PASS: multi-host launcher over network namespaces: bounded run with both hosts; remote actors stopped on exit, Ctrl-C, SIGTERM and SIGKILL"
+rm -rf "$work"

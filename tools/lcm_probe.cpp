@@ -1,0 +1,198 @@
+// masa_lcm_probe: listen on masa's LCM channels and report, per channel, how many messages came,
+// their size, their rate and (for messages that carry a publication time, utime) the latency from
+// publication to reception. Publisher and probe must share a clock: on one host this is exact;
+// across hosts it is only as good as their clock synchronization.
+//   masa_lcm_probe                                       # MASA_POLICY on the loopback URL, until Ctrl-C
+//   masa_lcm_probe --channel MASA_POLICY --duration 60 --run-id 42 --csv policy.csv
+//   masa_lcm_probe --all --url 'udpm://239.255.76.67:7690?ttl=0&recv_buf_size=8388608'
+// The latency includes what the publisher does after stamping utime (encoding, sending every
+// fragment), the network, LCM's reassembly and the probe's own scheduling: under load, it is what
+// a subscriber that polls without delay would see.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/transport/channels.hpp"
+#include "common/transport/lcm_url.hpp"
+#include "common/transport/transport.hpp"
+#include "masa/lcmt_actor_heartbeat.hpp"
+#include "masa/lcmt_learner_stats.hpp"
+#include "masa/lcmt_policy_params.hpp"
+
+namespace {
+
+using namespace masa;
+
+std::atomic<bool> g_stop{false};
+extern "C" void onSignal(int) { g_stop.store(true); }
+
+// What the probe can read from one message: run id, publication time, and a version or sequence
+// where the type has one. Channels of unknown type give none of these.
+struct Stamp {
+  int64_t run_id = 0;
+  int64_t utime = 0;
+  int64_t version = -1;
+};
+
+template <class Msg>
+std::optional<Msg> decodeAs(const void* data, int size) {
+  Msg m;
+  try {
+    if (m.decode(data, 0, size) == size) return m;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+std::optional<Stamp> readStamp(const std::string& channel, const void* data, int size) {
+  if (channel == transport::kPolicyChannel) {
+    if (auto m = decodeAs<masa::lcmt_policy_params>(data, size)) return Stamp{m->run_id, m->utime, m->version};
+  } else if (channel == transport::kLearnerStatsChannel) {
+    if (auto m = decodeAs<masa::lcmt_learner_stats>(data, size)) return Stamp{m->run_id, m->utime, m->version};
+  } else if (channel == transport::kHeartbeatChannel) {
+    if (auto m = decodeAs<masa::lcmt_actor_heartbeat>(data, size)) return Stamp{m->run_id, m->utime, m->actor_id};
+  }
+  return std::nullopt;
+}
+
+// Nearest-rank percentile of a sorted sample.
+double percentile(const std::vector<double>& sorted, double p) {
+  if (sorted.empty()) return 0.0;
+  const auto rank = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(sorted.size())));
+  return sorted[std::clamp<std::size_t>(rank, 1, sorted.size()) - 1];
+}
+
+struct ChannelLog {
+  int64_t messages = 0, bytes = 0, undecoded = 0;
+  std::vector<double> sizes, latencies_ms;
+  std::map<int64_t, int> versions;  // policy version -> times received (repeats are normal)
+  int64_t first_us = 0, last_us = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Report message counts, sizes, rates and publication-to-reception latency on masa's LCM channels"};
+  std::string url = transport::loopbackUrl();
+  std::vector<std::string> channels;
+  bool all = false, quiet = false;
+  double duration_s = 0.0;
+  int64_t max_count = 0, run_id = 0;
+  std::string csv_path;
+  app.add_option("--url", url, "LCM provider URL")->capture_default_str();
+  app.add_option("--channel", channels, "channel to listen on (repeatable; default MASA_POLICY)");
+  app.add_flag("--all", all, "listen on all four masa channels");
+  app.add_option("--duration", duration_s, "stop after this many seconds (0: until Ctrl-C or --count)");
+  app.add_option("--count", max_count, "stop after this many messages in all (0: no limit)");
+  app.add_option("--run-id", run_id, "count only messages of this run (0: any run)");
+  app.add_option("--csv", csv_path, "write one row per message: channel,recv_us,utime,latency_us,bytes,version");
+  app.add_flag("--quiet", quiet, "print the summary only, not one line per message");
+  CLI11_PARSE(app, argc, argv);
+  if (all)
+    channels = {transport::kPolicyChannel, transport::kLearnerStatsChannel, transport::kHeartbeatChannel,
+                transport::kRolloutChannel};
+  if (channels.empty()) channels = {transport::kPolicyChannel};
+
+  std::ofstream csv;
+  if (!csv_path.empty()) {
+    csv.open(csv_path);
+    if (!csv) {
+      std::fprintf(stderr, "masa_lcm_probe: cannot write %s\n", csv_path.c_str());
+      return 2;
+    }
+    csv << "channel,recv_us,utime,latency_us,bytes,version\n";
+  }
+
+  std::map<std::string, ChannelLog> logs;
+  int64_t total = 0;
+  try {
+    transport::Transport bus(url);
+    if (!bus.recvBufCheck().sufficient) std::fprintf(stderr, "masa_lcm_probe: %s\n", bus.recvBufCheck().message.c_str());
+    for (const std::string& ch : channels) {
+      logs[ch];
+      bus.subscribeRaw(ch, [&, ch](const void* data, int size) {
+        const int64_t now = transport::wallClockMicros();  // first: decoding is not the network's time
+        const auto stamp = readStamp(ch, data, size);
+        if (stamp && run_id != 0 && stamp->run_id != run_id) return;
+        ChannelLog& log = logs[ch];
+        if (log.messages == 0) log.first_us = now;
+        log.last_us = now;
+        ++log.messages;
+        ++total;
+        log.bytes += size;
+        log.sizes.push_back(size);
+        double latency_us = -1.0;
+        if (stamp) {
+          latency_us = static_cast<double>(now - stamp->utime);
+          log.latencies_ms.push_back(latency_us / 1000.0);
+          if (ch == transport::kPolicyChannel) ++log.versions[stamp->version];
+        } else if (ch != transport::kRolloutChannel) {
+          ++log.undecoded;
+        }
+        if (csv.is_open())
+          csv << ch << ',' << now << ',' << (stamp ? stamp->utime : 0) << ',' << latency_us << ',' << size << ','
+              << (stamp ? stamp->version : -1) << '\n';
+        if (!quiet && stamp)
+          std::printf("%s  %d B  version/id %lld  latency %.3f ms\n", ch.c_str(), size,
+                      static_cast<long long>(stamp->version), latency_us / 1000.0);
+      });
+    }
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    std::fprintf(stderr, "masa_lcm_probe: listening on %s\n", url.c_str());
+    const auto start = std::chrono::steady_clock::now();
+    while (!g_stop.load()) {
+      if (bus.handleTimeout(100) < 0) {
+        if (g_stop.load()) break;  // the signal interrupted the wait: a normal end
+        std::fprintf(stderr, "masa_lcm_probe: LCM error while receiving\n");
+        return 1;
+      }
+      if (max_count > 0 && total >= max_count) break;
+      if (duration_s > 0 &&
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= duration_s)
+        break;
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "masa_lcm_probe: %s\n", e.what());
+    return 2;
+  }
+
+  std::printf("channel               count   rate/s    MB/s  bytes(median)  bytes(max)  latency ms: median     p99     max\n");
+  for (auto& [ch, log] : logs) {
+    std::sort(log.sizes.begin(), log.sizes.end());
+    std::sort(log.latencies_ms.begin(), log.latencies_ms.end());
+    const double span_s = (log.last_us - log.first_us) / 1e6;
+    // Rate over the span between the first and the last message (n - 1 intervals).
+    const double rate = span_s > 0 ? (log.messages - 1) / span_s : 0.0;
+    const double mbps = span_s > 0 ? log.bytes / span_s / 1e6 : 0.0;
+    std::printf("%-20s %6lld %8.1f %7.2f %14.0f %11.0f", ch.c_str(), static_cast<long long>(log.messages), rate, mbps,
+                percentile(log.sizes, 50), log.sizes.empty() ? 0.0 : log.sizes.back());
+    if (!log.latencies_ms.empty())
+      std::printf("             %7.3f %7.3f %7.3f", percentile(log.latencies_ms, 50), percentile(log.latencies_ms, 99),
+                  log.latencies_ms.back());
+    std::printf("\n");
+    if (!log.versions.empty()) {
+      // Versions received, and those never seen between the first and the last (lost broadcasts
+      // that were not repeated before the next one replaced them).
+      const int64_t lo = log.versions.begin()->first, hi = log.versions.rbegin()->first;
+      const int64_t missing = (hi - lo + 1) - static_cast<int64_t>(log.versions.size());
+      std::printf("  %s: versions %lld..%lld, %zu distinct, %lld never received\n", ch.c_str(),
+                  static_cast<long long>(lo), static_cast<long long>(hi), log.versions.size(),
+                  static_cast<long long>(missing));
+    }
+    if (log.undecoded > 0)
+      std::printf("  %s: %lld messages did not decode as the channel's type\n", ch.c_str(),
+                  static_cast<long long>(log.undecoded));
+  }
+  return 0;
+}

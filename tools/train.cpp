@@ -1,0 +1,91 @@
+// masa_train: the learner and one actor in one process, over an in-process memq:// LCM.
+//
+// The same Learner and Actor classes as masa_learner / masa_actor, taking turns: the actor collects
+// one rollout of all ppo.num_envs environments, the learner updates on it, the actor picks up the
+// new parameters. Nothing is lost or stale, so a seed gives the same run on every machine: for
+// debugging, learning checks and small experiments. The run directory is the learner's (config,
+// metrics, checkpoint, learning curve).
+//   masa_train --set task=a1_beam --set method=sa --updates 50 --run-dir runs/a1_sa
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "actors/actor.hpp"
+#include "common/config/run_config.hpp"
+#include "common/model/method.hpp"
+#include "learner/learner.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+extern "C" void onSignal(int) { g_stop.store(true); }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"masa train: learner and one actor in one process (deterministic, no network)"};
+  std::vector<std::string> overrides;
+  std::string configs = masa::config::defaultConfigsDir();
+  std::string run_dir;
+  int64_t updates = 50;
+  int threads = 1;
+  bool quiet = false;
+  app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set task=a1_beam");
+  app.add_option("--configs", configs, "configs directory")->capture_default_str();
+  app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_inprocess)");
+  app.add_option("--updates", updates, "PPO updates to make")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--threads", threads, "OpenMP threads over the environments")->capture_default_str()
+      ->check(CLI::Range(1, 1024));
+  app.add_flag("--quiet", quiet, "no progress line per update");
+  CLI11_PARSE(app, argc, argv);
+
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  try {
+    const auto rc = masa::config::loadRunConfig(configs, overrides);
+    if (run_dir.empty())
+      run_dir = "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" + std::to_string(rc.seed) +
+                "_inprocess";
+    masa::learner::LearnerOptions lo;
+    lo.url = "memq://";
+    lo.run_dir = run_dir;
+    lo.run_id = 1;
+    lo.verbose = !quiet;
+    masa::learner::Learner learner(rc, lo);
+    learner.setMaxUpdates(updates);
+
+    masa::actor::ActorOptions ao;
+    ao.num_envs = rc.ppo.num_envs;
+    ao.run_id = lo.run_id;
+    ao.threads = threads;
+    ao.first_rollout_seq = 0;
+    ao.heartbeat_interval_s = 1e9;  // nobody listens
+    ao.stop = &g_stop;
+    masa::actor::Actor actor(rc, ao, &learner.transport());
+    std::fprintf(stderr, "masa_train: %s / %s, %d envs x %d steps per update, %lld updates, run dir %s\n",
+                 rc.task.c_str(), masa::model::methodName(rc.method).c_str(), rc.ppo.num_envs, rc.ppo.horizon,
+                 static_cast<long long>(updates), learner.runDir().c_str());
+
+    while (!g_stop.load() && learner.epoch() < updates) {
+      if (!actor.pollParams(0)) {
+        learner.publishParams();  // the first broadcast may predate the actor's subscription
+        if (!actor.pollParams(0)) throw std::runtime_error("the actor received no parameters from the learner");
+      }
+      if (!actor.collectAndPublish()) break;  // stopped mid-rollout
+      bool updated = false;
+      for (int tries = 0; !updated && tries < 100; ++tries) updated = learner.step(0);
+      if (!updated) throw std::runtime_error("the learner made no update from a whole rollout (see its warnings)");
+    }
+    learner.writeCheckpoint();
+    learner.renderLearningCurve();
+    std::fprintf(stderr, "masa_train: %lld updates, %lld env steps; run dir %s\n",
+                 static_cast<long long>(learner.epoch()), static_cast<long long>(learner.envSteps()),
+                 learner.runDir().c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "masa_train: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
