@@ -71,12 +71,7 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
   num_terms_ = static_cast<int>(terms.size());
 
   model_ = std::make_unique<model::ActorCritic<float>>(spec, config_.model);
-  policy_param_count_ = model_->params().size();
-  for (const auto& seg : model_->params().segments())
-    if (seg.name.rfind("critic", 0) == 0) {
-      policy_param_count_ = seg.offset;
-      break;
-    }
+  policy_param_count_ = model_->policyParamCount();
   {
     // Own initial parameters: used only with start_without_learner, and deterministic per seed.
     Rng init_rng = envRng(config_.seed, options_.actor_id, -1);

@@ -267,9 +267,10 @@ void Learner::publishParams() {
   m.version = version_;
   m.method = model::methodName(rc_.method);
   m.task = rc_.task;
+  // The policy prefix only: the critic is the learner's business, and it halves the broadcast.
   const auto& p = model_->params().values();
-  m.num_params = static_cast<int32_t>(p.size());
-  m.params.assign(p.data(), p.data() + p.size());
+  m.num_params = model_->policyParamCount();
+  m.params.assign(p.data(), p.data() + m.num_params);
   if (model_->config().normalize_obs) {
     auto& norm = model_->obsNormalizer();
     m.obs_dim = norm.dim();

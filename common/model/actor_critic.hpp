@@ -51,6 +51,13 @@ class ActorCritic {
 
   nn::ParameterSet<S>& params() { return params_; }
   const nn::ParameterSet<S>& params() const { return params_; }
+  // The flat parameters start with the policy and its log-std, then the critic ("critic*"
+  // segments): actors and deployed controllers need only this prefix.
+  int policyParamCount() const {
+    for (const auto& seg : params_.segments())
+      if (seg.name.rfind("critic", 0) == 0) return seg.offset;
+    return params_.size();
+  }
   RunningMeanStd<S>& obsNormalizer() { return obs_norm_; }
   RunningMeanStd<S>& valueNormalizer() { return value_norm_; }
 
