@@ -4,13 +4,14 @@
 # comparison plot per task (mean return over seeds against env steps, one line per method).
 #   experiments/grid.sh --tasks "a1_beam ant_acrobatic" --methods "masa sa sasa ma" --seeds "0 1 2" \
 #       --updates 300 [--jobs N] [--out DIR] [--set key=value ...]
+#   experiments/grid.sh --replot --out DIR --tasks ... --methods ... --seeds ...   (summary and plots only)
 # Results: DIR/<task>/<method>_s<seed>/ (the run directories: config.yaml, metrics.csv, ...),
 # DIR/<task>/summary.csv (final return per run: mean of the last 10 updates) and
 # DIR/<task>/compare.png. MASA_BUILD_DIR chooses the build (default build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-tasks="a1_beam" methods="masa sa" seeds="0" updates=200 jobs=$(nproc) out="" sets=()
+tasks="a1_beam" methods="masa sa" seeds="0" updates=200 jobs=$(nproc) out="" sets=() replot=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --tasks) tasks=$2; shift 2 ;;
@@ -20,39 +21,44 @@ while [ $# -gt 0 ]; do
     --jobs) jobs=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
+    --replot) replot=1; shift ;;
     *) echo "grid.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 build=${MASA_BUILD_DIR:-build}
 train="$build/tools/masa_train"
-[ -x "$train" ] || { echo "grid.sh: $train is missing: run deploy/build.sh first" >&2; exit 2; }
-out=${out:-experiments/results/grid_$(date +%Y%m%d_%H%M%S)}
-mkdir -p "$out"
+if [ "$replot" = 1 ]; then
+  [ -n "$out" ] && [ -d "$out" ] || { echo "grid.sh: --replot needs --out with an existing grid" >&2; exit 2; }
+else
+  [ -x "$train" ] || { echo "grid.sh: $train is missing: run deploy/build.sh first" >&2; exit 2; }
+  out=${out:-experiments/results/grid_$(date +%Y%m%d_%H%M%S)}
+  mkdir -p "$out"
 
-# One line per run; xargs runs them `jobs` at a time, each on one thread.
-runs="$out/runs.txt"
-: > "$runs"
-for t in $tasks; do for m in $methods; do for s in $seeds; do echo "$t $m $s" >> "$runs"; done; done; done
-total=$(wc -l < "$runs")
-echo "grid.sh: $total runs ($tasks / $methods / seeds $seeds), $updates updates each, $jobs at a time, into $out"
-printf '%s\n' "${sets[@]+"${sets[@]}"}" > "$out/sets.txt"
+  # One line per run; xargs runs them `jobs` at a time, each on one thread.
+  runs="$out/runs.txt"
+  : > "$runs"
+  for t in $tasks; do for m in $methods; do for s in $seeds; do echo "$t $m $s" >> "$runs"; done; done; done
+  total=$(wc -l < "$runs")
+  echo "grid.sh: $total runs ($tasks / $methods / seeds $seeds), $updates updates each, $jobs at a time, into $out"
+  printf '%s\n' "${sets[@]+"${sets[@]}"}" > "$out/sets.txt"
 
-export train updates out
-run_one() {
-  local t=$1 m=$2 s=$3 dir="$out/$1/$2_s$3"
-  mapfile -t extra < "$out/sets.txt"
-  local args=()
-  for x in "${extra[@]}"; do [ -n "$x" ] && args+=("$x"); done
-  if OMP_NUM_THREADS=1 "$train" --quiet --updates "$updates" --run-dir "$dir" \
-       --set task="$t" --set method="$m" --set seed="$s" "${args[@]}" > "$dir.log" 2>&1; then
-    echo "grid.sh: done $t $m seed $s"
-  else
-    echo "grid.sh: FAILED $t $m seed $s (see $dir.log)"
-  fi
-}
-export -f run_one
-mkdir -p $(for t in $tasks; do echo "$out/$t"; done)
-xargs -P "$jobs" -L 1 bash -c 'run_one "$@"' _ < "$runs"
+  export train updates out
+  run_one() {
+    local t=$1 m=$2 s=$3 dir="$out/$1/$2_s$3"
+    mapfile -t extra < "$out/sets.txt"
+    local args=()
+    for x in "${extra[@]}"; do [ -n "$x" ] && args+=("$x"); done
+    if OMP_NUM_THREADS=1 "$train" --quiet --updates "$updates" --run-dir "$dir" \
+         --set task="$t" --set method="$m" --set seed="$s" "${args[@]}" > "$dir.log" 2>&1; then
+      echo "grid.sh: done $t $m seed $s"
+    else
+      echo "grid.sh: FAILED $t $m seed $s (see $dir.log)"
+    fi
+  }
+  export -f run_one
+  mkdir -p $(for t in $tasks; do echo "$out/$t"; done)
+  xargs -P "$jobs" -L 1 bash -c 'run_one "$@"' _ < "$runs"
+fi
 
 for t in $tasks; do
   summary="$out/$t/summary.csv"
