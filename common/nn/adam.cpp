@@ -2,6 +2,7 @@
 //   p -= (lr / (1 - b1^t)) * m / (sqrt(v) / sqrt(1 - b2^t) + eps).
 #include "common/nn/adam.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -46,10 +47,19 @@ void Adam<S>::step() {
   const double bc2 = 1.0 - std::pow(static_cast<double>(b2), static_cast<double>(t_));
   const S step_size = static_cast<S>(config_.lr / bc1);
   const S inv_sqrt_bc2 = static_cast<S>(1.0 / std::sqrt(bc2));
-  auto g = params_->grads().array();
-  m_.array() = b1 * m_.array() + (S(1) - b1) * g;
-  v_.array() = b2 * v_.array() + (S(1) - b2) * g.square();
-  params_->values().array() -= step_size * m_.array() / (v_.array().sqrt() * inv_sqrt_bc2 + config_.eps);
+  // One pass in L1-sized blocks instead of three passes over the whole vectors; the arithmetic
+  // (and so every bit of the result) is that of the three whole-vector expressions.
+  constexpr Eigen::Index kBlock = 2048;
+  const Eigen::Index n = m_.size();
+  for (Eigen::Index i = 0; i < n; i += kBlock) {
+    const Eigen::Index len = std::min(kBlock, n - i);
+    auto g = params_->grads().segment(i, len).array();
+    auto m = m_.segment(i, len).array();
+    auto v = v_.segment(i, len).array();
+    m = b1 * m + (S(1) - b1) * g;
+    v = b2 * v + (S(1) - b2) * g.square();
+    params_->values().segment(i, len).array() -= step_size * m / (v.sqrt() * inv_sqrt_bc2 + config_.eps);
+  }
 }
 
 template <typename S>

@@ -1,12 +1,36 @@
 // Batched MLP forward/backward on buffers that only grow, so steady-state training allocates nothing.
 #include "common/nn/mlp.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "common/core/check.hpp"
 
 namespace masa::nn {
+
+namespace {
+using Eigen::Index;
+
+// Columns a thread takes through all layers at a time in the fused engine, so that a chunk's
+// activations (about 800 floats a column for the humanoid policy) stay in L2 between layers.
+constexpr int kChunk = 128;
+// Below these many columns per thread a second thread costs more than it saves (waking it takes
+// microseconds; backward also zeroes and sums a gradient partial of the whole network).
+constexpr int kMinForwardColumnsPerThread = 64;
+constexpr int kMinBackwardColumnsPerThread = 256;
+
+int paddedRows(int rows) { return (rows + 15) / 16 * 16; }
+
+// [begin, end) of part t of nt of n items, in multiples of 16.
+std::pair<int, int> columnRange(int n, int t, int nt) {
+  const int per = ((n + nt - 1) / nt + 15) / 16 * 16;
+  const int begin = std::min(n, t * per);
+  return {begin, std::min(n, begin + per)};
+}
+}  // namespace
 
 template <typename S>
 Mlp<S>::Mlp(ParameterSet<S>& params, const std::string& name, const MlpShape& shape) : params_(&params), shape_(shape) {
@@ -28,8 +52,18 @@ Mlp<S>::Mlp(ParameterSet<S>& params, const std::string& name, const MlpShape& sh
     l.act = k + 2 == widths.size() ? shape.output_activation : shape.hidden_activation;
     layers_.push_back(l);
   }
-  z_.resize(layers_.size());
   y_.resize(layers_.size());
+  param_begin_ = layers_.front().w_offset;
+  MASA_CHECK(layers_.back().b_offset + layers_.back().out == param_begin_ + numParams(),
+             "MLP '" << name << "': its parameters are not one contiguous range");
+  if constexpr (kFused) {
+    Index size = 0;
+    for (const Layer& l : layers_) {
+      packed_t_offset_.push_back(size);
+      size += dense::packedSize(l.in, l.out);
+    }
+    packed_t_.setZero(size);
+  }
   // Buffers and plans for zero columns, so that even an empty first batch finds them consistent.
   capacity_ = -1;
   reserve(0);
@@ -63,24 +97,40 @@ template <typename S>
 void Mlp<S>::reserve(int batch) {
   MASA_CHECK(batch >= 0, "MLP reserve: negative batch " << batch);
   if (batch <= capacity_) return;
-  int max_width = shape_.input;
-  for (size_t k = 0; k < layers_.size(); ++k) {
-    z_[k].resize(layers_[k].out, batch);
-    y_[k].resize(layers_[k].out, batch);
+  const int L = numLayers();
+  int max_width = shape_.input, max_padded = 16;
+  for (int k = 0; k < L; ++k) {
+    // Zeroed, so that the padding rows hold numbers and the pages are touched here, not in a step.
+    y_[k].setZero(k + 1 == L ? layers_[k].out : paddedRows(layers_[k].out), batch);
     max_width = std::max(max_width, layers_[k].out);
+    max_padded = std::max(max_padded, paddedRows(layers_[k].out));
   }
-  input_.resize(shape_.input, batch);
-  grad_a_.resize(max_width, batch);
-  grad_b_.resize(max_width, batch);
-  plans_.clear();
-  for (const Layer& l : layers_) {
-    plans_.push_back(GemmWorkspace<S>::plan(l.out, batch, l.in));
-    plans_.push_back(GemmWorkspace<S>::plan(l.out, l.in, batch));
-    plans_.push_back(GemmWorkspace<S>::plan(l.in, batch, l.out));
+  input_.setZero(shape_.input, batch);
+  if constexpr (kFused) {
+    const int threads = std::max(1, omp_get_max_threads());
+    scratch_.resize(threads);
+    for (Mat<S>& s : scratch_) s.setZero(max_padded, 2 * std::min(batch, kChunk));
+    grad_partial_.resize(threads - 1);
+    for (Vec<S>& g : grad_partial_) g.setZero(numParams());
+  } else {
+    grad_a_.resize(max_width, batch);
+    grad_b_.resize(max_width, batch);
+    plans_.clear();
+    for (const Layer& l : layers_) {
+      plans_.push_back(GemmWorkspace<S>::plan(l.out, batch, l.in));
+      plans_.push_back(GemmWorkspace<S>::plan(l.out, l.in, batch));
+      plans_.push_back(GemmWorkspace<S>::plan(l.in, batch, l.out));
+    }
+    gemm_.reserve(plans_);
   }
-  gemm_.reserve(plans_);
   capacity_ = batch;
   batch_ = -1;  // the caches of an earlier forward are gone
+}
+
+template <typename S>
+int Mlp<S>::threadsFor(int B, int min_columns_per_thread) const {
+  if (omp_in_parallel()) return 1;
+  return std::clamp(B / min_columns_per_thread, 1, std::max(1, omp_get_max_threads()));
 }
 
 template <typename S>
@@ -89,17 +139,11 @@ Eigen::Block<Mat<S>> Mlp<S>::forward(const ConstMatRef<S>& x) {
   MASA_CHECK(x.rows() == shape_.input, "MLP forward: input has " << x.rows() << " rows, expected " << shape_.input);
   const int B = static_cast<int>(x.cols());
   reserve(B);
-  input_.leftCols(B) = x;
-  for (size_t k = 0; k < layers_.size(); ++k) {
-    const Layer& l = layers_[k];
-    auto W = params_->value(l.w_offset, l.out, l.in);
-    auto b = params_->value(l.b_offset, l.out, 1);
-    auto z = z_[k].leftCols(B);
-    const Mat<S>& prev = k == 0 ? input_ : y_[k - 1];
-    gemm_.run(plans_[3 * k], false, false, l.out, B, l.in, W.data(), l.out, prev.data(), prev.rows(), z.data(),
-              z_[k].rows(), false);
-    z.colwise() += b.col(0);
-    activate<S>(l.act, z, y_[k].leftCols(B));
+  if constexpr (kFused) {
+    forwardFused(x.data(), x.outerStride(), B, true);
+  } else {
+    input_.leftCols(B) = x;
+    forwardGeneric(input_.data(), input_.rows(), B);
   }
   batch_ = B;
   return y_.back().block(0, 0, shape_.output, B);
@@ -111,20 +155,12 @@ Eigen::Block<Mat<S>> Mlp<S>::infer(const ConstMatRef<S>& x) {
   MASA_CHECK(x.rows() == shape_.input, "MLP infer: input has " << x.rows() << " rows, expected " << shape_.input);
   const int B = static_cast<int>(x.cols());
   reserve(B);
-  // Works in y_ only (activation in place), reading x directly: backward is no longer valid.
+  // Reads x directly and overwrites the activations: backward is no longer valid.
   batch_ = -1;
-  for (size_t k = 0; k < layers_.size(); ++k) {
-    const Layer& l = layers_[k];
-    auto W = params_->value(l.w_offset, l.out, l.in);
-    auto b = params_->value(l.b_offset, l.out, 1);
-    auto y = y_[k].leftCols(B);
-    const S* prev = k == 0 ? x.data() : y_[k - 1].data();
-    const Eigen::Index ld_prev = k == 0 ? x.outerStride() : y_[k - 1].rows();
-    gemm_.run(plans_[3 * k], false, false, l.out, B, l.in, W.data(), l.out, prev, ld_prev, y.data(), y_[k].rows(),
-              false);
-    y.colwise() += b.col(0);
-    activate<S>(l.act, y, y);
-  }
+  if constexpr (kFused)
+    forwardFused(x.data(), x.outerStride(), B, false);
+  else
+    forwardGeneric(x.data(), x.outerStride(), B);
   return y_.back().block(0, 0, shape_.output, B);
 }
 
@@ -137,16 +173,47 @@ void Mlp<S>::backward(const ConstMatRef<S>& dy, MatRef<S>* dx) {
   if (dx)
     MASA_CHECK(dx->rows() == shape_.input && dx->cols() == B,
                "MLP backward: dx is " << dx->rows() << "x" << dx->cols() << ", expected " << shape_.input << "x" << B);
+  if (B == 0) return;
+  if constexpr (kFused)
+    backwardFused(dy, dx);
+  else
+    backwardGeneric(dy, dx);
+}
 
+// ---- generic engine: one GemmWorkspace product per matrix, elementwise passes separate ----
+
+template <typename S>
+void Mlp<S>::forwardGeneric(const S* x, Index ldx, int B) {
+  const S* prev = x;
+  Index ld_prev = ldx;
+  for (size_t k = 0; k < layers_.size(); ++k) {
+    const Layer& l = layers_[k];
+    auto W = params_->value(l.w_offset, l.out, l.in);
+    auto b = params_->value(l.b_offset, l.out, 1);
+    Mat<S>& y_store = y_[k];
+    gemm_.run(plans_[3 * k], false, false, l.out, B, l.in, W.data(), l.out, prev, ld_prev, y_store.data(),
+              y_store.rows(), false);
+    auto y = y_store.topLeftCorner(l.out, B);
+    y.colwise() += b.col(0);
+    activate<S>(l.act, y, y);
+    prev = y_store.data();
+    ld_prev = y_store.rows();
+  }
+}
+
+template <typename S>
+void Mlp<S>::backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx) {
+  const int B = batch_;
   // dz of the current layer lives in `cur`; W^T dz goes to `next`, which becomes the previous
-  // layer's dz in place. The two scratch buffers swap roles each layer.
+  // layer's dz in place. The two scratch buffers swap roles each layer. Derivatives are taken
+  // from y (ReLU's y > 0 is z > 0).
   Mat<S>* cur = &grad_a_;
   Mat<S>* next = &grad_b_;
   const int L = numLayers();
-  if (B == 0) return;
   {
     const Layer& l = layers_[L - 1];
-    activateBackward<S>(l.act, z_[L - 1].leftCols(B), y_[L - 1].leftCols(B), dy, cur->topLeftCorner(l.out, B));
+    auto y = y_[L - 1].topLeftCorner(l.out, B);
+    activateBackward<S>(l.act, y, y, dy, cur->topLeftCorner(l.out, B));
   }
   for (int k = L - 1; k >= 0; --k) {
     const Layer& l = layers_[k];
@@ -167,8 +234,123 @@ void Mlp<S>::backward(const ConstMatRef<S>& dy, MatRef<S>* dx) {
     gemm_.run(plans_[3 * k + 2], true, false, l.in, B, l.out, W.data(), l.out, dz.data(), cur->rows(), dprev.data(),
               next->rows(), false);
     const Layer& lp = layers_[k - 1];
-    activateBackward<S>(lp.act, z_[k - 1].leftCols(B), y_[k - 1].leftCols(B), dprev, dprev);
+    auto y_prev = y_[k - 1].topLeftCorner(lp.out, B);
+    activateBackward<S>(lp.act, y_prev, y_prev, dprev, dprev);
     std::swap(cur, next);
+  }
+}
+
+// ---- fused engine (float, AVX-512): chunks of the batch through all layers, over threads ----
+//
+// Chunks are handed out dynamically: a thread whose core is shared with another process takes
+// fewer of them instead of holding the other one up at the end of the step.
+
+template <typename S>
+void Mlp<S>::forwardFused(const S* x, Index ldx, int B, bool keep_input) {
+  if constexpr (kFused) {
+    const S* values = params_->values().data();
+    const int L = numLayers();
+    auto chunk = [&](int j0) {
+      const int n = std::min(kChunk, B - j0);
+      const S* in = x + j0 * ldx;
+      Index ld_in = ldx;
+      if (keep_input) {
+        using Strided = Eigen::Map<const Mat<S>, 0, Eigen::OuterStride<>>;
+        input_.middleCols(j0, n) = Strided(in, shape_.input, n, Eigen::OuterStride<>(ldx));
+        in = input_.data() + j0 * input_.rows();
+        ld_in = input_.rows();
+      }
+      for (int k = 0; k < L; ++k) {
+        const Layer& l = layers_[k];
+        const Index ld_out = y_[k].rows();
+        S* out = y_[k].data() + j0 * ld_out;
+        dense::forward(values + l.w_offset, l.out, l.out, l.in, values + l.b_offset, l.act, in, ld_in, out, ld_out, n);
+        in = out;
+        ld_in = ld_out;
+      }
+    };
+    const int chunks = (B + kChunk - 1) / kChunk;
+    const int threads = std::min(chunks, threadsFor(B, kMinForwardColumnsPerThread));
+    if (threads <= 1) {
+      for (int c = 0; c < chunks; ++c) chunk(c * kChunk);
+      return;
+    }
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (int c = 0; c < chunks; ++c) chunk(c * kChunk);
+  }
+}
+
+template <typename S>
+void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
+  if constexpr (kFused) {
+    const int B = batch_;
+    const int L = numLayers();
+    const S* values = params_->values().data();
+    for (int k = dx ? 0 : 1; k < L; ++k) {
+      const Layer& l = layers_[k];
+      dense::pack(values + l.w_offset, l.out, true, l.in, l.out, packed_t_.data() + packed_t_offset_[k]);
+    }
+    // One chunk of columns through every layer, on thread t's scratch, into gradient `grad`.
+    auto chunk = [&](int j0, int t, S* grad) {
+      const int n = std::min(kChunk, B - j0);
+      Mat<S>& scratch = scratch_[t];
+      const Index ld_s = scratch.rows();
+      S* buffers[2] = {scratch.data(), scratch.data() + ld_s * (scratch.cols() / 2)};
+      int free_buffer = 0;
+      const Layer& last = layers_[L - 1];
+      const S* g = dy.data() + j0 * dy.outerStride();
+      Index ld_g = dy.outerStride();
+      if (last.act != Activation::kIdentity) {
+        using Strided = Eigen::Map<Mat<S>, 0, Eigen::OuterStride<>>;
+        using ConstStrided = Eigen::Map<const Mat<S>, 0, Eigen::OuterStride<>>;
+        const Index ld_y = y_[L - 1].rows();
+        const ConstStrided y(y_[L - 1].data() + j0 * ld_y, last.out, n, Eigen::OuterStride<>(ld_y));
+        activateBackward<S>(last.act, y, y, ConstStrided(g, last.out, n, Eigen::OuterStride<>(ld_g)),
+                            Strided(buffers[0], last.out, n, Eigen::OuterStride<>(ld_s)));
+        g = buffers[0];
+        ld_g = ld_s;
+        free_buffer = 1;
+      }
+      for (int k = L - 1; k >= 0; --k) {
+        const Layer& l = layers_[k];
+        const Index ld_x = k == 0 ? input_.rows() : y_[k - 1].rows();
+        const S* x_k = (k == 0 ? input_.data() : y_[k - 1].data()) + j0 * ld_x;
+        dense::weightGrad(l.out, l.in, n, g, ld_g, x_k, ld_x, grad + (l.w_offset - param_begin_),
+                          grad + (l.b_offset - param_begin_));
+        const S* packed = packed_t_.data() + packed_t_offset_[k];
+        if (k > 0) {
+          S* d = buffers[free_buffer];
+          dense::inputGrad(packed, l.in, l.out, g, ld_g, layers_[k - 1].act, x_k, ld_x, d, ld_s, n);
+          g = d;
+          ld_g = ld_s;
+          free_buffer ^= 1;
+        } else if (dx) {
+          dense::inputGrad(packed, l.in, l.out, g, ld_g, Activation::kIdentity, nullptr, 0,
+                           dx->data() + j0 * dx->outerStride(), dx->outerStride(), n);
+        }
+      }
+    };
+    S* grads = params_->grads().data() + param_begin_;
+    const int chunks = (B + kChunk - 1) / kChunk;
+    const int threads = std::min({chunks, threadsFor(B, kMinBackwardColumnsPerThread), static_cast<int>(scratch_.size())});
+    if (threads <= 1) {
+      for (int c = 0; c < chunks; ++c) chunk(c * kChunk, 0, grads);
+      return;
+    }
+    const int P = numParams();
+#pragma omp parallel num_threads(threads)
+    {
+      // Thread 0 accumulates into the parameter set, the others into zeroed partials summed below.
+      const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+      S* grad = t == 0 ? grads : grad_partial_[t - 1].data();
+      if (t > 0) grad_partial_[t - 1].setZero();
+#pragma omp for schedule(dynamic, 1)
+      for (int c = 0; c < chunks; ++c) chunk(c * kChunk, t, grad);
+      // (the loop's implicit barrier: every partial is complete)
+      const auto [p0, p1] = columnRange(P, t, nt);
+      Eigen::Map<Vec<S>> total(grads + p0, p1 - p0);
+      for (int u = 1; u < nt; ++u) total += grad_partial_[u - 1].segment(p0, p1 - p0);
+    }
   }
 }
 

@@ -3,13 +3,24 @@
 // Parameters live in a ParameterSet (flat); activation buffers are owned here and sized by
 // capacity: a batch up to the largest seen so far reuses them (leftCols views), so the training
 // loop allocates nothing after its first step.
+//
+// Two engines behind one interface. In float on AVX-512 machines (dense::kAvailable) the layers
+// run on the fused kernels of dense_kernels.hpp, and the batch is cut into chunks of 128 columns
+// that the OpenMP threads take in turn: a chunk goes through every layer while its activations
+// stay in L2, and each thread adds its weight gradients to its own partial, summed once at the
+// end (no synchronization between layers). Otherwise (double, or no AVX-512) every product is one
+// GemmWorkspace call and the elementwise work separate passes. Only post-activations are stored
+// (f' is computed from them); hidden ones have their rows padded to a multiple of 16 so that
+// every column starts 64-byte aligned.
 #pragma once
 
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "common/core/types.hpp"
 #include "common/nn/activation.hpp"
+#include "common/nn/dense_kernels.hpp"
 #include "common/nn/gemm.hpp"
 #include "common/nn/parameter_set.hpp"
 
@@ -54,18 +65,37 @@ class Mlp {
     int in, out, w_offset, b_offset;
     Activation act;
   };
+  static constexpr bool kFused = std::is_same_v<S, float> && dense::kAvailable;
+
+  void forwardGeneric(const S* x, Eigen::Index ldx, int B);
+  void backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx);
+  void forwardFused(const S* x, Eigen::Index ldx, int B, bool keep_input);
+  void backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx);
+  // Threads for a batch of B columns (1 inside a parallel region or for small batches).
+  int threadsFor(int B, int min_columns_per_thread) const;
+
   ParameterSet<S>* params_;
   MlpShape shape_;
   std::vector<Layer> layers_;
-  // Per layer: pre-activation z and post-activation y, capacity columns.
-  std::vector<Mat<S>> z_, y_;
+  std::vector<Mat<S>> y_;  // per layer: post-activation, capacity columns (hidden rows padded)
   Mat<S> input_;  // copy of the last forward's input (needed for the first layer's weight grad)
-  Mat<S> grad_a_, grad_b_;  // backward's dz, alternating between layers (widest layer x capacity)
-  // Products run on owned packing buffers (see gemm.hpp); per layer: forward, weight grad, input grad.
+  int batch_ = -1;  // columns of the last forward(); -1 when there is no cache for backward
+  int capacity_ = 0;
+
+  // Generic engine: backward's dz alternating between two buffers (widest layer x capacity);
+  // products on owned packing buffers (see gemm.hpp), per layer: forward, weight grad, input grad.
+  Mat<S> grad_a_, grad_b_;
   GemmWorkspace<S> gemm_;
   std::vector<GemmPlan> plans_;
-  int capacity_ = 0;
-  int batch_ = -1;  // columns of the last forward(); -1 when there is no cache for backward
+
+  // Fused engine: W^T of every layer packed for the input gradients; per thread two dz scratch
+  // blocks (widest layer x chunk); per thread but the first a gradient partial of this MLP's
+  // parameter range [param_begin_, param_begin_ + numParams()) (the first adds to the grads).
+  Vec<S> packed_t_;
+  std::vector<Eigen::Index> packed_t_offset_;
+  std::vector<Mat<S>> scratch_;
+  std::vector<Vec<S>> grad_partial_;
+  int param_begin_ = 0;
 };
 
 }  // namespace masa::nn

@@ -1,0 +1,55 @@
+// AVX-512 float kernels for the three products of a dense layer, with the elementwise work fused in.
+//
+// A layer's training step is Y = f(W X + b) forward, then dX = (W^T G) .* f'(Y_prev) and
+// dW += G X^T, db += G 1 backward, all column-major (features x batch). Each kernel keeps a
+// 48 x 8 tile of its result in registers (24 of the 32 zmm registers) and applies the bias,
+// activation or activation derivative to the tile before storing it, so no elementwise pass
+// goes over memory. The batch operand is read in place, which saves a packing pass over the
+// large operand; forward reads W in place too (its columns are the rows the tile needs), and
+// only W^T for the input gradient is packed, once per step.
+//
+// f' is computed from Y (ELU: min(y,0)+1; tanh: 1-y^2; ReLU: y>0), so z = Wx+b is never stored.
+// The caller splits the batch over threads: every function is single-threaded and allocates
+// nothing. The kernels exist where the compiler targets AVX-512F (kAvailable); elsewhere they
+// throw, and the MLP uses GemmWorkspace instead.
+#pragma once
+
+#include <cstddef>
+
+#include "common/nn/activation.hpp"
+
+namespace masa::nn::dense {
+
+#if defined(__AVX512F__)
+inline constexpr bool kAvailable = true;
+#else
+inline constexpr bool kAvailable = false;
+#endif
+
+using Index = std::ptrdiff_t;
+
+// Floats needed to pack a rows x depth operand (rows rounded up to a multiple of 16).
+Index packedSize(int rows, int depth);
+
+// Packs op(W) (rows x depth) into panels of 48 (or 32 or 16) rows, each stored as depth
+// consecutive groups of its rows, zero-padded. W is column-major with leading dimension ld;
+// op(W) = W when !transpose (W is rows x depth), W^T when transpose (W is depth x rows).
+// `packed` holds packedSize(rows, depth) floats.
+void pack(const float* w, Index ld, bool transpose, int rows, int depth, float* packed);
+
+// y = f(W x + bias) for n columns. W: rows x depth (ldw), read in place; x: depth x n (ldx);
+// y: rows x n (ldy); bias: rows values or null. Writes only the rows < `rows` of y.
+void forward(const float* w, Index ldw, int rows, int depth, const float* bias, Activation act, const float* x,
+             Index ldx, float* y, Index ldy, int n);
+
+// d = (P g) .* f'(y) for n columns, f' of `act` written in terms of y (y unused for identity).
+// P: packed rows x depth (W^T); g: depth x n (ldg); y, d: rows x n (ldy, ldd). d may not alias g.
+void inputGrad(const float* packed, int rows, int depth, const float* g, Index ldg, Activation act, const float* y,
+               Index ldy, float* d, Index ldd, int n);
+
+// dw += g x^T and db += row sums of g, over n columns. g: rows x n (ldg); x: cols x n (ldx);
+// dw: rows x cols with leading dimension rows; db: rows values or null.
+void weightGrad(int rows, int cols, int n, const float* g, Index ldg, const float* x, Index ldx, float* dw,
+                float* db);
+
+}  // namespace masa::nn::dense

@@ -1,0 +1,185 @@
+// The AVX-512 dense-layer kernels against plain Eigen products, over shapes that exercise every
+// panel width (48/32/16 rows, masked last vector), every column tile (8/4/2/1), strided operands
+// and all activations; and the fused MLP engine against the double-precision generic one.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <memory>
+#include <tuple>
+
+#include "common/nn/dense_kernels.hpp"
+#include "common/nn/mlp.hpp"
+
+namespace masa::nn {
+namespace {
+
+using Eigen::Index;
+
+Mat<double> reference(const Mat<float>& m) { return m.cast<double>(); }
+
+Mat<double> activated(Activation a, const Mat<double>& z) {
+  switch (a) {
+    case Activation::kIdentity: return z;
+    case Activation::kElu: return z.unaryExpr([](double v) { return v > 0 ? v : std::expm1(v); });
+    case Activation::kTanh: return z.array().tanh().matrix();
+    case Activation::kRelu: return z.cwiseMax(0.0);
+  }
+  return z;
+}
+
+Mat<double> derivativeFromY(Activation a, const Mat<double>& y) {
+  switch (a) {
+    case Activation::kIdentity: return Mat<double>::Ones(y.rows(), y.cols());
+    case Activation::kElu: return y.unaryExpr([](double v) { return v > 0 ? 1.0 : v + 1.0; });
+    case Activation::kTanh: return (1.0 - y.array().square()).matrix();
+    case Activation::kRelu: return y.unaryExpr([](double v) { return v > 0 ? 1.0 : 0.0; });
+  }
+  return y;
+}
+
+// (rows, depth, n): rows cover 1, 2 and 3-vector panels with and without a partial last vector;
+// n covers every column tile width.
+using Shape = std::tuple<int, int, int>;
+
+class DenseKernels : public ::testing::TestWithParam<Shape> {
+ protected:
+  void SetUp() override {
+    if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  }
+};
+
+TEST_P(DenseKernels, ForwardMatchesEigenForEveryActivationAndLeavesPaddingAlone) {
+  const auto [rows, depth, n] = GetParam();
+  const Mat<float> w_store = Mat<float>::Random(rows + 3, depth);  // ldw > rows
+  const Mat<float> x_store = Mat<float>::Random(depth + 5, n);
+  const Mat<float> bias = Mat<float>::Random(rows, 1);
+  const Mat<double> z = (reference(w_store.topRows(rows)) * reference(x_store.topRows(depth))).colwise() +
+                        reference(bias).col(0);
+  for (Activation a : {Activation::kIdentity, Activation::kElu, Activation::kTanh, Activation::kRelu}) {
+    Mat<float> y_store = Mat<float>::Constant(rows + 7, n, 42.f);
+    dense::forward(w_store.data(), w_store.rows(), rows, depth, bias.data(), a, x_store.data(), x_store.rows(),
+                   y_store.data(), y_store.rows(), n);
+    const double err = (reference(y_store.topRows(rows)) - activated(a, z)).cwiseAbs().maxCoeff();
+    EXPECT_LT(err, 2e-6 * depth + 1e-6) << activationName(a);
+    EXPECT_TRUE((y_store.bottomRows(7).array() == 42.f).all()) << activationName(a) << ": rows past `rows` written";
+  }
+  // Without bias.
+  Mat<float> y(rows, n);
+  dense::forward(w_store.data(), w_store.rows(), rows, depth, nullptr, Activation::kIdentity, x_store.data(),
+                 x_store.rows(), y.data(), rows, n);
+  const Mat<double> wx = reference(w_store.topRows(rows)) * reference(x_store.topRows(depth));
+  EXPECT_LT((reference(y) - wx).cwiseAbs().maxCoeff(), 2e-6 * depth + 1e-6);
+}
+
+TEST_P(DenseKernels, InputGradMatchesEigenTimesTheDerivativeFromY) {
+  // d (rows x n) = W^T g .* f'(y), with W stored depth x rows (a layer of `depth` outputs).
+  const auto [rows, depth, n] = GetParam();
+  const Mat<float> w = Mat<float>::Random(depth, rows);
+  std::vector<float, Eigen::aligned_allocator<float>> packed(dense::packedSize(rows, depth));
+  dense::pack(w.data(), w.rows(), true, rows, depth, packed.data());
+  const Mat<float> g_store = Mat<float>::Random(depth + 2, n);
+  const Mat<float> y_store = Mat<float>::Random(rows + 4, n);
+  const Mat<double> wtg = reference(w).transpose() * reference(g_store.topRows(depth));
+  for (Activation a : {Activation::kIdentity, Activation::kElu, Activation::kTanh, Activation::kRelu}) {
+    Mat<float> d_store = Mat<float>::Constant(rows + 1, n, -3.f);
+    dense::inputGrad(packed.data(), rows, depth, g_store.data(), g_store.rows(), a, y_store.data(), y_store.rows(),
+                     d_store.data(), d_store.rows(), n);
+    const Mat<double> expected = (wtg.array() * derivativeFromY(a, reference(y_store.topRows(rows))).array()).matrix();
+    EXPECT_LT((reference(d_store.topRows(rows)) - expected).cwiseAbs().maxCoeff(), 2e-6 * depth + 1e-6)
+        << activationName(a);
+    EXPECT_TRUE((d_store.bottomRows(1).array() == -3.f).all()) << activationName(a);
+  }
+}
+
+TEST_P(DenseKernels, WeightGradAccumulatesProductAndRowSums) {
+  // dw (rows x cols) += g x^T over n columns, db += g 1; here `depth` plays cols.
+  const auto [rows, cols, n] = GetParam();
+  const Mat<float> g_store = Mat<float>::Random(rows + 3, n);
+  const Mat<float> x_store = Mat<float>::Random(cols + 1, n);
+  const Mat<float> dw0 = Mat<float>::Random(rows, cols);
+  const Mat<float> db0 = Mat<float>::Random(rows, 1);
+  Mat<float> dw = dw0, db = db0;
+  dense::weightGrad(rows, cols, n, g_store.data(), g_store.rows(), x_store.data(), x_store.rows(), dw.data(),
+                    db.data());
+  const Mat<double> g = reference(g_store.topRows(rows));
+  const Mat<double> expected_w = reference(dw0) + g * reference(x_store.topRows(cols)).transpose();
+  const Mat<double> expected_b = reference(db0) + g.rowwise().sum();
+  EXPECT_LT((reference(dw) - expected_w).cwiseAbs().maxCoeff(), 2e-6 * n + 1e-6);
+  EXPECT_LT((reference(db) - expected_b).cwiseAbs().maxCoeff(), 2e-6 * n + 1e-6);
+  // Without db.
+  Mat<float> dw2 = Mat<float>::Zero(rows, cols);
+  dense::weightGrad(rows, cols, n, g_store.data(), g_store.rows(), x_store.data(), x_store.rows(), dw2.data(), nullptr);
+  EXPECT_LT((reference(dw2) - g * reference(x_store.topRows(cols)).transpose()).cwiseAbs().maxCoeff(), 2e-6 * n + 1e-6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shapes, DenseKernels,
+                         ::testing::Values(Shape{1, 1, 1}, Shape{5, 3, 2}, Shape{16, 7, 8}, Shape{21, 100, 15},
+                                           Shape{33, 4, 9}, Shape{48, 16, 17}, Shape{64, 5, 3}, Shape{100, 200, 31},
+                                           Shape{200, 74, 129}, Shape{400, 21, 7}, Shape{74, 400, 300}));
+
+TEST(DenseKernelsPack, PanelsHoldRowsOfOpWZeroPadded) {
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  // 70 rows = 5 vectors = one 48-row panel and one 32-row panel (22 valid rows).
+  const int rows = 70, depth = 3;
+  const Mat<float> w = Mat<float>::Random(rows, depth);
+  std::vector<float> packed(dense::packedSize(rows, depth), -1.f);
+  ASSERT_EQ(packed.size(), size_t{80 * 3});
+  dense::pack(w.data(), rows, false, rows, depth, packed.data());
+  for (int k = 0; k < depth; ++k) {
+    for (int r = 0; r < 48; ++r) EXPECT_EQ(packed[k * 48 + r], w(r, k));
+    for (int r = 0; r < 32; ++r) EXPECT_EQ(packed[48 * depth + k * 32 + r], r < 22 ? w(48 + r, k) : 0.f);
+  }
+}
+
+// The fused float engine against the double generic one, same parameters: outputs, parameter
+// gradients and input gradients, at batches that use one thread, several, and partial chunks.
+void expectFusedMatchesGeneric(const MlpShape& shape, int batch, int threads) {
+  ParameterSet<float> pf;
+  ParameterSet<double> pd;
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  Mlp<float> f(pf, "net", shape);
+  Mlp<double> d(pd, "net", shape);
+  pf.finalize();
+  pd.finalize();
+  Rng rng(3);
+  f.initialize(rng);
+  pd.values() = pf.values().cast<double>();
+  const Mat<float> x = Mat<float>::Random(shape.input, batch);
+  const Mat<float> dy = Mat<float>::Random(shape.output, batch);
+  const Mat<double> yd = d.forward(x.cast<double>());
+  const Mat<float> yf = f.forward(x);
+  EXPECT_LT((yf.cast<double>() - yd).cwiseAbs().maxCoeff(), 1e-4) << "forward, batch " << batch;
+  EXPECT_EQ(f.infer(x), yf) << "infer and forward differ";
+  f.forward(x);
+
+  Mat<float> dxf(shape.input, batch);
+  Mat<double> dxd(shape.input, batch);
+  MatRef<float> dxf_ref(dxf);
+  MatRef<double> dxd_ref(dxd);
+  pf.grads().setConstant(0.5f);  // backward accumulates
+  pd.grads().setConstant(0.5);
+  f.backward(dy, &dxf_ref);
+  d.backward(dy.cast<double>(), &dxd_ref);
+  const double scale = 1.0 + pd.grads().cwiseAbs().maxCoeff();
+  EXPECT_LT((pf.grads().cast<double>() - pd.grads()).cwiseAbs().maxCoeff(), 1e-5 * scale) << "grads, batch " << batch;
+  EXPECT_LT((dxf.cast<double>() - dxd).cwiseAbs().maxCoeff(), 1e-4) << "dx, batch " << batch;
+  omp_set_num_threads(saved);
+}
+
+TEST(MlpFusedEngine, MatchesTheGenericEngineInDoubleForTheHumanoidPolicy) {
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  const MlpShape shape{74, {400, 200, 100}, 21, Activation::kElu, Activation::kIdentity};
+  for (int batch : {1, 13, 300, 1000}) expectFusedMatchesGeneric(shape, batch, 2);
+  expectFusedMatchesGeneric(shape, 777, 1);
+}
+
+TEST(MlpFusedEngine, MatchesTheGenericEngineForOtherActivationsAndWidths) {
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  expectFusedMatchesGeneric(MlpShape{9, {33, 17}, 3, Activation::kTanh, Activation::kTanh}, 600, 2);
+  expectFusedMatchesGeneric(MlpShape{5, {64}, 1, Activation::kRelu, Activation::kElu}, 530, 2);
+  expectFusedMatchesGeneric(MlpShape{7, {}, 2, Activation::kElu, Activation::kIdentity}, 40, 2);
+}
+
+}  // namespace
+}  // namespace masa::nn
