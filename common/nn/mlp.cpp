@@ -242,8 +242,10 @@ void Mlp<S>::backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx) {
 
 // ---- fused engine (float, AVX-512): chunks of the batch through all layers, over threads ----
 //
-// Chunks are handed out dynamically: a thread whose core is shared with another process takes
-// fewer of them instead of holding the other one up at the end of the step.
+// Forward chunks are handed out dynamically: a thread whose core is shared with another process
+// takes fewer of them instead of holding the other one up at the end of the step (each column's
+// result is the same whoever computes it). Backward chunks are split statically: they are summed
+// into per-thread gradients, and the summation order must not depend on timing.
 
 template <typename S>
 void Mlp<S>::forwardFused(const S* x, Index ldx, int B, bool keep_input) {
@@ -344,7 +346,9 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
       const int t = omp_get_thread_num(), nt = omp_get_num_threads();
       S* grad = t == 0 ? grads : grad_partial_[t - 1].data();
       if (t > 0) grad_partial_[t - 1].setZero();
-#pragma omp for schedule(dynamic, 1)
+      // Static: which chunks a thread sums must not depend on timing, or the float sums (and so
+      // the whole run) would differ between runs of the same seed.
+#pragma omp for schedule(static)
       for (int c = 0; c < chunks; ++c) chunk(c * kChunk, t, grad);
       // (the loop's implicit barrier: every partial is complete)
       const auto [p0, p1] = columnRange(P, t, nt);
