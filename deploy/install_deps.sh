@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package masa needs to build, test, run and monitor.
 # Idempotent: packages already present are left alone; safe to run again.
+#   deploy/install_deps.sh [--bench]
 set -euo pipefail
 
 packages=(
@@ -23,6 +24,12 @@ packages=(
   # the run directory's learning_curve.png
   gnuplot-nox
 )
+
+# --bench: also the packages that only the comparison benchmarks need (never CI, never a training
+# run): LibTorch for bench/libtorch/ and OpenBLAS for its tuned set-up. Installing libopenblas0
+# makes OpenBLAS the system's libblas.so.3; masa links no BLAS, and bench/run_learner_vs_libtorch.sh
+# picks each set-up's BLAS explicitly.
+if [ "${1:-}" = --bench ]; then packages=(libtorch-dev libopenblas-dev); fi
 
 missing=()
 for p in "${packages[@]}"; do
