@@ -69,6 +69,17 @@ struct FakeLearner {
   config::RunConfig rc;
 };
 
+// The learner's chunk gate, configured for this test run's dimensions (warnings off).
+transport::AssemblerConfig assemblerConfigFor(const FakeLearner& learner) {
+  transport::AssemblerConfig ac;
+  ac.run_id = kRunId;
+  ac.horizon = kHorizon;
+  ac.obs_dim = learner.spec.obsDim();
+  ac.act_dim = learner.spec.actDim();
+  ac.warn_interval_s = -1;
+  return ac;
+}
+
 struct Capture {
   explicit Capture(transport::Transport& t) {
     t.subscribeRaw(transport::kRolloutChannel, [this](const void* d, int n) {
@@ -112,13 +123,7 @@ TEST(ActorRollouts, ChunksFromLearnerParamsPassTheAssemblerWithAllEnvsAndEpisode
   bus.drain();
   ASSERT_EQ(actor.paramsRejected(), 0);
 
-  transport::AssemblerConfig ac;
-  ac.run_id = kRunId;
-  ac.horizon = kHorizon;
-  ac.obs_dim = learner.spec.obsDim();
-  ac.act_dim = learner.spec.actDim();
-  ac.warn_interval_s = -1;
-  transport::RolloutAssembler assembler(ac);
+  transport::RolloutAssembler assembler(assemblerConfigFor(learner));
   assembler.setLearnerVersion(1);
   ASSERT_GE(cap.chunks.size(), 4u) << "expected each rollout split into at least two chunks";
   std::vector<std::set<int>> envs_seen(2);
@@ -289,13 +294,7 @@ TEST(ActorRollouts, ARestartedActorNumbersItsRolloutsPastItsPreviousProcessAndIs
     bus.drain();
   }
   EXPECT_GT(first_seq[1], first_seq[0] + 2) << "the restart numbers past every rollout the first process sent";
-  transport::AssemblerConfig ac;
-  ac.run_id = kRunId;
-  ac.horizon = kHorizon;
-  ac.obs_dim = learner.spec.obsDim();
-  ac.act_dim = learner.spec.actDim();
-  ac.warn_interval_s = -1;
-  transport::RolloutAssembler assembler(ac);
+  transport::RolloutAssembler assembler(assemblerConfigFor(learner));
   assembler.setLearnerVersion(1);
   for (const auto& bytes : cap.chunks) {
     const auto v = assembler.acceptEncoded(bytes.data(), static_cast<int>(bytes.size()));
