@@ -165,10 +165,13 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
   const float max_norm = static_cast<float>(config_.grad_norm);
   const Mat<float>& obs = buffer.obs();
   const Mat<float>& actions = buffer.actions();
-  const Mat<float>& means = buffer.means();
-  const Mat<float>& old_log_stds = buffer.logStds();
   const Mat<float>& log_probs = buffer.logProbs();
   PpoStats st = prepared_;
+  // The KL that drives the learning rate compares each minibatch with the policy of its previous
+  // visit (rl_games' update_mu_sigma): it starts at the collection policy and is overwritten after
+  // every minibatch. The ratio of the surrogate keeps the collection log-probabilities.
+  kl_ref_mean_ = buffer.means();
+  kl_ref_log_std_ = buffer.logStds();
 
   for (int epoch = 0; epoch < config_.mini_epochs; ++epoch) {
     // Fisher-Yates with the raw engine output: the same permutation on every standard library.
@@ -180,8 +183,8 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
         const int c = idx[j];
         mb_obs_.col(j) = obs.col(c);
         mb_actions_.col(j) = actions.col(c);
-        mb_old_mean_.col(j) = means.col(c);
-        mb_old_log_std_.col(j) = old_log_stds.col(c);
+        mb_old_mean_.col(j) = kl_ref_mean_.col(c);
+        mb_old_log_std_.col(j) = kl_ref_log_std_.col(c);
         mb_old_log_prob_(0, j) = log_probs(0, c);
         mb_adv_(0, j) = advantages_(0, c);
         mb_old_value_(0, j) = old_values_(0, c);
@@ -193,6 +196,10 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
       const PpoLossBatch<float> batch{model.mean(), log_std_,   model.value(), mb_actions_,   mb_old_log_prob_,
                                       mb_old_mean_, mb_old_log_std_, mb_adv_, mb_old_value_, mb_returns_};
       const PpoLossStats ls = loss_.compute(batch);
+      for (int j = 0; j < m; ++j) {
+        kl_ref_mean_.col(idx[j]) = model.mean().col(j);
+        kl_ref_log_std_.col(idx[j]) = log_std_;
+      }
 
       params.zeroGrad();
       model.backward(loss_.dmean(), loss_.dlogStd(), loss_.dvalue());

@@ -9,8 +9,9 @@
 //                  clipped value loss compares like with like
 //               5. advantages normalized by their batch mean and (unbiased) std
 //   optimize(): mini_epochs x shuffled minibatches: forward, loss, backward, grad-norm clip, Adam
-//               step, then the adaptive lr from that minibatch's KL(old || new) (measured before
-//               the step, as rl_games does). Allocates nothing once the sizes have been seen.
+//               step, then the adaptive lr from that minibatch's KL(previous visit || new),
+//               measured before the step as rl_games does: the drift of one mini-epoch, not of
+//               all mini-epochs since collection. Allocates nothing once the sizes have been seen.
 // update() = prepare() + optimize().
 #pragma once
 
@@ -77,6 +78,7 @@ class PpoTrainer {
   Vec<float> bootstrap_values_;                   // E
   Mat<float> final_values_;                       // 1 x number of time-outs
   std::vector<int> order_;                        // minibatch shuffle
+  Mat<float> kl_ref_mean_, kl_ref_log_std_;       // act x T*E: each sample's policy at its last visit (KL)
 
   // Per minibatch.
   Mat<float> mb_obs_, mb_actions_, mb_old_mean_, mb_old_log_std_, mb_old_log_prob_, mb_adv_, mb_old_value_, mb_returns_;

@@ -134,6 +134,32 @@ INSTANTIATE_TEST_SUITE_P(PpoMethods, PpoTrainerUpdate,
                                            model::Method::kMa),
                          [](const auto& info) { return model::methodName(info.param); });
 
+// rl_games' KL for the adaptive lr measures one mini-epoch's drift: after a minibatch is used, its
+// stored mean and std become the policy's at that visit. A batch collected by a policy far from the
+// model (means shifted by 1) has a large KL on the first visit; on the second visit the KL must only
+// measure the small step in between, not the distance to the collection policy again.
+TEST(PpoTrainerKl, SecondMiniEpochMeasuresTheDriftSinceTheFirstNotSinceCollection) {
+  config::PpoConfig ppo = smallPpo();
+  ppo.minibatch_size = kEnvs * kHorizon;  // one minibatch per mini-epoch
+  ppo.learning_rate = 1e-4;
+  auto firstVisitKl = [&](int mini_epochs) {
+    config::PpoConfig c = ppo;
+    c.mini_epochs = mini_epochs;
+    Rig s(model::Method::kSa, c);
+    Rng rng(11);
+    fillOneStepBatch(s, rng);
+    s.buffer->means().array() += 1.0f;  // behaviour policy != the model
+    return s.trainer->update(*s.buffer, rng);
+  };
+  const PpoStats one = firstVisitKl(1), two = firstVisitKl(2);
+  ASSERT_EQ(two.minibatches, 2);
+  const double kl_first = one.kl;                  // KL(collection || model) on the first visit
+  const double kl_second = 2.0 * two.kl - one.kl;  // the second visit's KL
+  EXPECT_GT(kl_first, 0.2);  // every action shifted by one std: 0.5 per action
+  EXPECT_GE(kl_second, 0.0);
+  EXPECT_LT(kl_second, 0.01 * kl_first) << "the second mini-epoch's KL still measures the distance to collection";
+}
+
 TEST(PpoTrainerPrepare, TimeOutsBootstrapFromFinalObsAndHorizonEndFromBootstrapObs) {
   config::PpoConfig ppo = smallPpo();
   ppo.normalize_value = false;  // values are then the critic's outputs as they are
