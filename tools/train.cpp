@@ -6,6 +6,7 @@
 // debugging, learning checks and small experiments. The run directory is the learner's (config,
 // metrics, checkpoint, learning curve).
 //   masa_train --set task=a1_beam --set method=sa --updates 50 --run-dir runs/a1_sa
+//   masa_train --recipe a1_beam --threads 2     (configs/recipes/a1_beam.yaml, its ppo.max_epochs updates)
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
@@ -29,13 +30,16 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   std::string configs = masa::config::defaultConfigsDir();
   std::string run_dir;
-  int64_t updates = 50;
+  int64_t updates = 0;
+  std::string recipe;
   int threads = 1;
   bool quiet = false;
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set task=a1_beam");
   app.add_option("--configs", configs, "configs directory")->capture_default_str();
   app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_inprocess)");
-  app.add_option("--updates", updates, "PPO updates to make")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--recipe", recipe, "a recipe of configs/recipes/ (or a YAML file), applied before --set");
+  app.add_option("--updates", updates, "PPO updates to make in total (default: ppo.max_epochs)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--threads", threads, "OpenMP threads over the environments")->capture_default_str()
       ->check(CLI::Range(1, 1024));
   app.add_flag("--quiet", quiet, "no progress line per update");
@@ -44,7 +48,9 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   try {
+    if (!recipe.empty()) overrides.insert(overrides.begin(), "@" + recipe);
     const auto rc = masa::config::loadRunConfig(configs, overrides);
+    if (updates == 0) updates = rc.ppo.max_epochs;
     if (run_dir.empty())
       run_dir = "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" + std::to_string(rc.seed) +
                 "_inprocess";

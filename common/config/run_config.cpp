@@ -146,6 +146,19 @@ class Reader {
   std::string defaults_;
 };
 
+// "@x" names a recipe: a file path as given, or configs/recipes/x.yaml.
+std::string resolveRecipe(const std::string& configs_dir, const std::string& name) {
+  if (name.empty()) throw ConfigError(kCommandLine, "@", "expected @<recipe name or file>");
+  if (fs::exists(name) && !fs::is_directory(name)) return name;
+  const std::string in_configs = configs_dir + "/recipes/" + name + ".yaml";
+  if (fs::exists(in_configs)) return in_configs;
+  std::string known;
+  if (fs::exists(configs_dir + "/recipes"))
+    for (const auto& e : fs::directory_iterator(configs_dir + "/recipes"))
+      if (e.path().extension() == ".yaml") known += (known.empty() ? "" : ", ") + e.path().stem().string();
+  throw ConfigError(kCommandLine, "@" + name, "no recipe file '" + name + "' nor " + in_configs + " (recipes: " + known + ")");
+}
+
 }  // namespace
 
 std::string defaultConfigsDir() {
@@ -155,6 +168,25 @@ std::string defaultConfigsDir() {
 
 RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides,
                         const std::string& base_file) {
+  YAML::Node base;
+  if (!base_file.empty()) base = loadYamlFile(base_file, "(file)");
+  return loadRunConfigOver(configs_dir, overrides, base, base_file);
+}
+
+RunConfig loadRunConfigText(const std::string& configs_dir, const std::string& yaml_text,
+                            const std::string& source_name, const std::vector<std::string>& overrides) {
+  YAML::Node base;
+  try {
+    base = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(source_name, "(syntax)", "YAML error at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (!base.IsMap()) throw ConfigError(source_name, "(root)", "expected a map of settings");
+  return loadRunConfigOver(configs_dir, overrides, base, source_name);
+}
+
+RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<std::string>& overrides,
+                            const YAML::Node& base, const std::string& base_file) {
   const std::string defaults_file = configs_dir + "/defaults.yaml";
   const YAML::Node schema = loadYamlFile(defaults_file, "(file)");
   RunConfig rc;
@@ -162,12 +194,19 @@ RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::s
 
   // Parse overrides first: the task they name decides which task file is read.
   std::vector<std::pair<std::string, YAML::Node>> parsed;
+  std::vector<std::pair<std::string, YAML::Node>> recipe_files;  // "@file.yaml" overrides: (file, tree)
   // A run's own config.yaml (resume) replaces the task file as the middle layer: it already holds
   // the task file's values as they were when the run started.
-  YAML::Node base;
-  if (!base_file.empty()) base = loadYamlFile(base_file, "(file)");
-  std::string task = base && base["task"] ? base["task"].as<std::string>() : schema["task"].as<std::string>();
+  const bool has_base = base.IsMap();
+  std::string task = has_base && base["task"] ? base["task"].as<std::string>() : schema["task"].as<std::string>();
   for (const std::string& o : overrides) {
+    if (!o.empty() && o[0] == '@') {  // a recipe: a whole YAML overlay, checked like a task file
+      const std::string file = resolveRecipe(configs_dir, o.substr(1));
+      const YAML::Node node = loadYamlFile(file, "(file)");
+      if (node.IsMap() && node["task"]) task = node["task"].as<std::string>();
+      recipe_files.emplace_back(file, node);
+      continue;
+    }
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0)
       throw ConfigError(kCommandLine, o, "expected key.path=value");
@@ -182,16 +221,19 @@ RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::s
     parsed.emplace_back(path, value);
   }
 
-  const std::string task_file = base_file.empty() ? configs_dir + "/tasks/" + task + ".yaml" : base_file;
-  if (!fs::exists(task_file)) {
+  const std::string task_file = has_base ? base_file : configs_dir + "/tasks/" + task + ".yaml";
+  if (!has_base && !fs::exists(task_file)) {
     std::string known;
     if (fs::exists(configs_dir + "/tasks"))
       for (const auto& e : fs::directory_iterator(configs_dir + "/tasks"))
         if (e.path().extension() == ".yaml") known += (known.empty() ? "" : ", ") + e.path().stem().string();
     throw ConfigError(task_file, "task", "unknown task '" + task + "' (known: " + known + ")");
   }
-  const YAML::Node task_node = loadYamlFile(task_file, "task");
+  const YAML::Node task_node = has_base ? base : loadYamlFile(task_file, "task");
   if (task_node.IsDefined() && !task_node.IsNull()) overlay(merged, task_node, schema, "", task_file, rc.origin);
+
+  for (const auto& [file, node] : recipe_files)
+    if (node.IsDefined() && !node.IsNull()) overlay(merged, node, schema, "", file, rc.origin);
 
   for (const auto& [path, value] : parsed) {
     // Build {a: {b: value}} and overlay it, so overrides get exactly the file checks.
@@ -268,6 +310,8 @@ RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::s
   u.checkpoint_every = r.atLeast("runner.checkpoint_every", 0);
   u.republish_every_s = r.positive("runner.republish_every_s");
   u.plot_every = r.atLeast("runner.plot_every", 0);
+  u.eval_every = r.atLeast("runner.eval_every", 0);
+  u.eval_episodes = r.atLeast("runner.eval_episodes", 1);
 
   rc.env = YAML::Clone(merged["env"]);
   rc.resolved = merged;

@@ -45,6 +45,8 @@ struct RunnerConfig {
   int checkpoint_every = 10;       // updates between checkpoints (0: only on exit)
   double republish_every_s = 1.0;  // seconds between parameter re-broadcasts
   int plot_every = 10;             // updates between learning-curve renders (0: only on exit)
+  int eval_every = 50;             // updates between evaluations of the policy mean (0: never)
+  int eval_episodes = 8;           // episodes per evaluation
 };
 
 struct RunConfig {
@@ -61,11 +63,19 @@ struct RunConfig {
 };
 
 // configs_dir holds defaults.yaml, tasks/ and specs/. overrides are "a.b=value" strings where value
-// is YAML (1e-4, true, [256, 128], elu).
+// is YAML (1e-4, true, [256, 128], elu), or "@recipe": a YAML file overlaid after the task file
+// (a path, or the name of one in configs/recipes/), checked like a task file; it may name the task.
 // base_file, when given, is read instead of the task file: a run directory's config.yaml, so that a
 // resumed run continues with exactly the configuration it started with (overrides still apply).
 RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides,
                         const std::string& base_file = "");
+
+// The same from a resolved configuration held as text (a policy file's), named source_name in errors.
+RunConfig loadRunConfigText(const std::string& configs_dir, const std::string& yaml_text,
+                            const std::string& source_name, const std::vector<std::string>& overrides = {});
+// The same with the middle layer given as a tree (empty: the task file), named base_file in errors.
+RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<std::string>& overrides,
+                            const YAML::Node& base, const std::string& base_file);
 
 // The configs directory of this source tree (MASA_SOURCE_DIR/configs) unless MASA_CONFIGS is set.
 std::string defaultConfigsDir();
