@@ -4,6 +4,7 @@
 // Prints the verdict and the worst observation entries and joints; exit 0 on pass, 1 on fail,
 // 2 on bad input.
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
 
 #include "common/config/run_config.hpp"
@@ -46,7 +47,8 @@ int main(int argc, char** argv) {
         return 2;
       }
       YAML::Node env;
-      env["model_file"] = model_file;
+      // Relative to where the user stands, not to the source tree (the registry's base for its tasks).
+      env["model_file"] = std::filesystem::absolute(model_file).string();
       factory = std::make_unique<task::TaskFactory>("mjcf", sym::SymmetrySpec::load(spec_file), env,
                                                     std::map<std::string, std::string>{}, "command line");
     }
