@@ -1,6 +1,7 @@
 #include "learner/learner.hpp"
 
 #include <cmath>
+#include <omp.h>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -10,6 +11,9 @@
 #include <stdexcept>
 
 #include "common/core/check.hpp"
+#include "common/policy/policy_file.hpp"
+#include "common/task/policy_evaluator.hpp"
+#include "learner/checkpoint.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/drop_reason.hpp"
@@ -22,21 +26,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kCheckpointMagic[8] = {'M', 'A', 'S', 'A', 'C', 'K', 'P', '1'};
 // RunningMeanStd's default epsilon: the broadcast std is sqrt(var + eps), what the learner divides by.
 constexpr double kObsEps = 1e-5;
 
-template <class T>
-void writePod(std::ostream& os, const T& v) {
-  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <class T>
-T readPod(std::istream& is) {
-  T v{};
-  is.read(reinterpret_cast<char*>(&v), sizeof(T));
-  if (!is) throw std::runtime_error("checkpoint: truncated");
-  return v;
-}
 
 model::ModelConfig modelConfigOf(const config::RunConfig& rc) {
   model::ModelConfig m = rc.model;
@@ -92,8 +84,29 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   transport_ = std::make_unique<transport::Transport>(opt_.url);
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
 
+  if (rc_.runner.eval_every > 0) {
+    eval_factory_ = std::make_unique<task::TaskFactory>(rc_.task, spec, rc_.env, rc_.origin);
+    eval_progress_names_ = eval_factory_->create()->progressNames();
+  }
+
   start_ = last_update_ = std::chrono::steady_clock::now();
   publishParams();
+}
+
+void Learner::evaluate() {
+  // Fixed seeds, far from the actors' (each evaluation sees the same starts: curves compare).
+  task::EvalOptions o;
+  o.episodes = rc_.runner.eval_episodes;
+  o.seed = 1000000;
+  o.deterministic = true;
+  o.threads = omp_get_max_threads();
+  task::PolicyEvaluator evaluator(*eval_factory_, *model_);
+  const task::EvalSummary s = evaluator.run(o);
+  report_.eval_return = s.ret.mean;
+  report_.eval_length = s.length.mean;
+  report_.eval_success = s.success_rate >= 0 ? s.success_rate : std::nan("");
+  report_.eval_progress.clear();
+  for (const auto& m : s.progress) report_.eval_progress.push_back(m.mean);
 }
 
 Learner::~Learner() = default;
@@ -232,6 +245,9 @@ void Learner::update(const transport::RolloutBatch& batch) {
   update_interval_s_ = epoch_ <= 2 ? dt : 0.8 * update_interval_s_ + 0.2 * dt;
   summarizeEpisodes(batch.data);
   report_.dropped = droppedTotal();
+  report_.eval_return = report_.eval_length = report_.eval_success = std::nan("");
+  report_.eval_progress.assign(eval_progress_names_.size(), std::nan(""));
+  if (eval_factory_ && epoch_ % rc_.runner.eval_every == 0) evaluate();
 
   assembler_->setLearnerVersion(version_);
   collector_->setLearnerVersion(version_);
@@ -250,11 +266,21 @@ void Learner::update(const transport::RolloutBatch& batch) {
     }
     char total[32] = "";
     if (max_updates_ > 0) std::snprintf(total, sizeof(total), "/%lld", static_cast<long long>(max_updates_));
-    std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f  success %.2f  kl %.5f  lr %.2e  "
+    char success[32] = "";  // only for tasks with a success notion
+    if (report_.success_rate >= 0) std::snprintf(success, sizeof(success), "  success %.2f", report_.success_rate);
+    std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f%s  kl %.5f  lr %.2e  "
                 "actor %.4f  critic %.4f  dropped %lld%s\n",
                 static_cast<long long>(epoch_), total, static_cast<long long>(env_steps_), report_.fps,
-                report_.mean_return, report_.mean_length, report_.success_rate, report_.ppo.kl, report_.ppo.lr,
+                report_.mean_return, report_.mean_length, success, report_.ppo.kl, report_.ppo.lr,
                 report_.ppo.actor_loss, report_.ppo.critic_loss, static_cast<long long>(report_.dropped), eta);
+    if (!std::isnan(report_.eval_return)) {
+      std::printf("  eval (policy mean, %d episodes): return %.3f  len %.1f", rc_.runner.eval_episodes,
+                  report_.eval_return, report_.eval_length);
+      if (!std::isnan(report_.eval_success)) std::printf("  success %.2f", report_.eval_success);
+      for (size_t i = 0; i < eval_progress_names_.size(); ++i)
+        std::printf("  %s %.3f", eval_progress_names_[i].c_str(), report_.eval_progress[i]);
+      std::printf("\n");
+    }
     std::fflush(stdout);
   }
   if (rc_.runner.checkpoint_every > 0 && epoch_ % rc_.runner.checkpoint_every == 0) writeCheckpoint();
@@ -335,7 +361,10 @@ void Learner::appendCsv() {
     f << "epoch,version,env_steps,wall_time_s,fps,return,length,success";
     if (collector_)
       for (const auto& t : collector_->config().term_names) f << ",term_" << t;
-    f << ",actor_loss,critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped\n";
+    f << ",actor_loss,critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped";
+    f << ",eval_return,eval_length,eval_success";
+    for (const auto& n : eval_progress_names_) f << ",eval_" << n;
+    f << '\n';
   }
   const ppo::PpoStats& p = report_.ppo;
   f.precision(9);
@@ -344,68 +373,42 @@ void Learner::appendCsv() {
   for (double t : report_.term_means) f << ',' << t;
   f << ',' << p.actor_loss << ',' << p.critic_loss << ',' << p.entropy << ',' << p.bounds_loss << ','
     << p.sym_policy_loss << ',' << p.sym_value_loss << ',' << p.kl << ',' << p.lr << ',' << p.grad_norm << ','
-    << p.explained_variance << ',' << report_.dropped << '\n';
+    << p.explained_variance << ',' << report_.dropped;
+  f << ',' << report_.eval_return << ',' << report_.eval_length << ',' << report_.eval_success;
+  for (double v : report_.eval_progress) f << ',' << v;
+  f << '\n';
 }
 
 void Learner::writeCheckpoint() {
-  const fs::path path = fs::path(dir_) / "checkpoint.bin";
-  const fs::path tmp = fs::path(dir_) / "checkpoint.bin.tmp";
-  {
-    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-    os.write(kCheckpointMagic, sizeof(kCheckpointMagic));
-    writePod(os, run_id_);
-    writePod(os, epoch_);
-    writePod(os, version_);
-    writePod(os, env_steps_);
-    writePod(os, wallTime());
-    writePod(os, trainer_->learningRate().lr());
-    std::ostringstream rng_text;
-    rng_text << rng_;
-    const std::string r = rng_text.str();
-    writePod(os, static_cast<uint64_t>(r.size()));
-    os.write(r.data(), static_cast<std::streamsize>(r.size()));
-    const auto& order = trainer_->shuffleOrder();
-    writePod(os, static_cast<uint64_t>(order.size()));
-    os.write(reinterpret_cast<const char*>(order.data()), static_cast<std::streamsize>(order.size() * sizeof(int)));
-    model_->save(os);
-    adam_->save(os);
-    os.flush();
-    if (!os) throw std::runtime_error("checkpoint: cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);  // atomic on POSIX: a crash leaves the old or the new checkpoint, never half
+  CheckpointState s;
+  s.run_id = run_id_;
+  s.updates = epoch_;
+  s.version = version_;
+  s.env_steps = env_steps_;
+  s.wall_time_s = wallTime();
+  s.lr = trainer_->learningRate().lr();
+  std::ostringstream rng_text;
+  rng_text << rng_;
+  s.rng_state = rng_text.str();
+  s.order = trainer_->shuffleOrder();
+  learner::writeCheckpoint((fs::path(dir_) / "checkpoint.bin").string(), s, *model_, *adam_);
+  // What inference needs, for evaluation and deployment (masa_eval, the robot runner).
+  policy::savePolicyFile((fs::path(dir_) / "policy.bin").string(), rc_, *model_);
 }
 
 void Learner::loadCheckpoint() {
-  const fs::path path = fs::path(dir_) / "checkpoint.bin";
-  std::ifstream is(path, std::ios::binary);
-  if (!is) throw std::runtime_error("resume: cannot open " + path.string());
-  char magic[sizeof(kCheckpointMagic)];
-  is.read(magic, sizeof(magic));
-  if (!is || std::memcmp(magic, kCheckpointMagic, sizeof(magic)) != 0)
-    throw std::runtime_error("resume: " + path.string() + " is not a masa learner checkpoint");
-  const int64_t run_id = readPod<int64_t>(is);
-  if (run_id_ == 0) run_id_ = run_id;  // keep the run: its actors go on being accepted
-  epoch_ = readPod<int64_t>(is);
-  version_ = readPod<int64_t>(is);
-  env_steps_ = readPod<int64_t>(is);
-  wall_offset_s_ = readPod<double>(is);
-  const double lr = readPod<double>(is);
-  const uint64_t rn = readPod<uint64_t>(is);
-  if (rn > (1u << 20)) throw std::runtime_error("resume: corrupt rng state");
-  std::string r(rn, '\0');
-  is.read(r.data(), static_cast<std::streamsize>(rn));
-  std::istringstream rng_text(r);
+  const CheckpointState s = readCheckpoint((fs::path(dir_) / "checkpoint.bin").string(), *model_, adam_.get());
+  if (run_id_ == 0) run_id_ = s.run_id;  // keep the run: its actors go on being accepted
+  epoch_ = s.updates;
+  version_ = s.version;
+  env_steps_ = s.env_steps;
+  wall_offset_s_ = s.wall_time_s;
+  std::istringstream rng_text(s.rng_state);
   rng_text >> rng_;
-  if (!is || !rng_text) throw std::runtime_error("resume: corrupt rng state");
-  const uint64_t on = readPod<uint64_t>(is);
-  if (on > (1ull << 31)) throw std::runtime_error("resume: corrupt shuffle order");
-  restored_order_.resize(on);
-  is.read(reinterpret_cast<char*>(restored_order_.data()), static_cast<std::streamsize>(on * sizeof(int)));
-  if (!is) throw std::runtime_error("checkpoint: truncated");
-  model_->load(is, path.string());
-  adam_->load(is);
-  trainer_->learningRate().setLr(lr);
-  adam_->config().lr = static_cast<float>(lr);
+  if (!rng_text) throw std::runtime_error("resume: corrupt rng state in " + dir_ + "/checkpoint.bin");
+  restored_order_ = s.order;
+  trainer_->learningRate().setLr(s.lr);
+  adam_->config().lr = static_cast<float>(s.lr);
 }
 
 }  // namespace masa::learner

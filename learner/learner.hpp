@@ -6,11 +6,13 @@
 // batch as soon as enough environments from whoever is alive have arrived, and the parameters are
 // re-published periodically so that a lost broadcast never stalls the actors.
 //
-// Run directory: config.yaml (resolved config), metrics.csv (one row per update), checkpoint.bin
-// (written atomically: tmp + rename).
+// Run directory: config.yaml (resolved config), metrics.csv (one row per update, with an evaluation
+// of the policy mean every runner.eval_every updates), checkpoint.bin (learner state, to resume) and
+// policy.bin (what inference needs: masa_eval, deployment), both written atomically (tmp + rename).
 #pragma once
 
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -20,6 +22,7 @@
 #include "common/config/run_config.hpp"
 #include "common/model/actor_critic.hpp"
 #include "common/nn/adam.hpp"
+#include "common/task/registry.hpp"
 #include "common/transport/batch_collector.hpp"
 #include "common/transport/rollout_assembler.hpp"
 #include "common/transport/transport.hpp"
@@ -46,6 +49,9 @@ struct UpdateReport {
   std::vector<double> term_means;
   ppo::PpoStats ppo;
   int64_t dropped = 0;
+  // The policy mean's evaluation (runner.eval_every): NaN in updates without one.
+  double eval_return = std::nan(""), eval_length = std::nan(""), eval_success = std::nan("");
+  std::vector<double> eval_progress;  // the task's progress figures (Task::progressNames)
 };
 
 class Learner {
@@ -90,6 +96,7 @@ class Learner {
   void publishStats();
   void appendCsv();
   void loadCheckpoint();
+  void evaluate();
   double wallTime() const;
 
   config::RunConfig rc_;
@@ -117,6 +124,9 @@ class Learner {
   int64_t max_updates_ = -1;              // of the current run(), for the ETA; -1: unknown
   double update_interval_s_ = 0;          // moving average of the wall time between updates
   UpdateReport report_;
+  // The task, built once, for the evaluations of runner.eval_every (null when they are off).
+  std::unique_ptr<task::TaskFactory> eval_factory_;
+  std::vector<std::string> eval_progress_names_;
 };
 
 }  // namespace masa::learner

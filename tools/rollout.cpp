@@ -14,6 +14,7 @@
 #include "common/model/actor_critic.hpp"
 #include "common/model/diag_gaussian.hpp"
 #include "common/render/offscreen_renderer.hpp"
+#include "common/render/strip_sampler.hpp"
 #include "common/task/registry.hpp"
 
 using namespace masa;
@@ -59,15 +60,17 @@ int main(int argc, char** argv) {
     std::unique_ptr<render::OffscreenRenderer> renderer;
     std::unique_ptr<render::FrameWriter> writer;
     int render_every = 1, frames = 0;
+    bool is_strip = false;
+    render::StripSampler sampler(std::max(1, strip));  // a strip shows the first episode
     const int limit = max_steps > 0 ? std::min(max_steps, env->maxEpisodeSteps()) : env->maxEpisodeSteps();
     if (!video.empty()) {
       renderer = std::make_unique<render::OffscreenRenderer>(env->model(), width, height);
       // Small scenes (TriFinger) from their extent; long ones (a 100 m rope) at a walking robot's scale.
       if (camera_distance <= 0) camera_distance = std::min(3.0, 1.5 * env->model()->stat.extent);
-      renderer->trackBody(1, camera_distance, 135.0, -20.0);
-      writer = std::make_unique<render::FrameWriter>(video, renderer->width(), renderer->height(), fps, strip);
+      renderer->trackBody(render::rootBody(env->model()), camera_distance, 135.0, -20.0);
+      is_strip = video.size() > 4 && video.substr(video.size() - 4) == ".png";
+      if (!is_strip) writer = std::make_unique<render::FrameWriter>(video, renderer->width(), renderer->height(), fps);
       render_every = std::max(1, static_cast<int>(std::lround(1.0 / (fps * env->controlTimestep()))));
-      if (writer->isStrip()) render_every = std::max(1, limit / strip);
     }
 
     Rng rng(seed);
@@ -98,9 +101,14 @@ int main(int argc, char** argv) {
           for (int k = 0; k < env->actDim(); ++k) act(k) = uniform(rng);
         }
         const task::StepOutcome o = env->step(act.data());
-        if (writer && t % render_every == 0 && (!writer->isStrip() || frames < writer->stripFrames())) {
+        const bool last = o.terminated || o.truncated || t + 1 == limit;
+        if (writer && t % render_every == 0) {
           writer->write(renderer->render(env->data()));
           ++frames;
+        } else if (is_strip && e == 0 && sampler.wants(t)) {
+          sampler.add(t, renderer->render(env->data()));
+        } else if (is_strip && e == 0 && last) {
+          sampler.addLast(t, renderer->render(env->data()));
         }
         if (o.terminated || o.truncated) break;
       }
@@ -118,6 +126,12 @@ int main(int argc, char** argv) {
     if (env->episode().has_success) std::printf(", success rate %.2f", double(successes) / episodes);
     std::printf("\nreward terms (mean sum per episode):\n");
     for (size_t k = 0; k < names.size(); ++k) std::printf("  %-14s %10.3f\n", names[k].c_str(), term_total[k] / episodes);
+    if (is_strip) {
+      const auto picked = sampler.pick();
+      render::FrameWriter strip_writer(video, renderer->width(), renderer->height(), fps, static_cast<int>(picked.size()));
+      for (const auto* image : picked) strip_writer.write(*image);
+      frames = static_cast<int>(picked.size());
+    }
     writer.reset();  // ffmpeg finishes the file
     if (!video.empty()) std::printf("wrote %s (%d frames)\n", video.c_str(), frames);
   } catch (const ConfigError& e) {

@@ -43,23 +43,49 @@ OffscreenRenderer::~OffscreenRenderer() {
 }
 
 void OffscreenRenderer::trackBody(int body, double distance, double azimuth_deg, double elevation_deg) {
-  camera_.type = mjCAMERA_TRACKING;
-  camera_.trackbodyid = body;
+  // A free camera re-aimed at the body on every frame: MuJoCo's tracking camera eases towards its
+  // body a little per render, so sparse frames (a strip) would lose the robot.
+  camera_.type = mjCAMERA_FREE;
+  track_body_ = body;
   camera_.distance = distance;
   camera_.azimuth = azimuth_deg;
   camera_.elevation = elevation_deg;
 }
 
-const std::vector<unsigned char>& OffscreenRenderer::render(const mjData* data) {
+const std::vector<unsigned char>& OffscreenRenderer::render(const mjData* data, const std::string& label) {
   mjrRect viewport{0, 0, width_, height_};
+  if (track_body_ >= 0)
+    for (int k = 0; k < 3; ++k) camera_.lookat[k] = data->xpos[3 * track_body_ + k];
   mjv_updateScene(model_, const_cast<mjData*>(data), &option_, nullptr, &camera_, mjCAT_ALL, &scene_);
   mjr_render(viewport, &scene_, &context_);
+  if (!label.empty()) mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, viewport, label.c_str(), nullptr, &context_);
   mjr_readPixels(rgb_.data(), nullptr, viewport, &context_);
   // OpenGL rows start at the bottom.
   const size_t row = static_cast<size_t>(width_) * 3;
   for (int y = 0; y < height_; ++y)
     std::memcpy(flipped_.data() + y * row, rgb_.data() + (height_ - 1 - y) * row, row);
   return flipped_;
+}
+
+double robotViewDistance(const mjModel* model, const mjData* data) {
+  const int root = rootBody(model);
+  double radius = 0.0;
+  for (int b = root + 1; b < model->nbody; ++b) {
+    int up = b;
+    while (up > root) up = model->body_parentid[up];
+    if (up != root) continue;  // not in the root's subtree
+    double d = 0.0;
+    for (int k = 0; k < 3; ++k) d += (data->xpos[3 * b + k] - data->xpos[3 * root + k]) * (data->xpos[3 * b + k] - data->xpos[3 * root + k]);
+    radius = std::max(radius, std::sqrt(d));
+  }
+  if (radius <= 0.0) return std::min(3.0, 1.5 * model->stat.extent);
+  return std::clamp(4.0 * radius, 0.6, std::min(4.0, 1.5 * model->stat.extent));
+}
+
+int rootBody(const mjModel* model) {
+  for (int j = 0; j < model->njnt; ++j)
+    if (model->jnt_type[j] == mjJNT_FREE) return model->jnt_bodyid[j];
+  return model->nbody > 1 ? 1 : 0;
 }
 
 FrameWriter::FrameWriter(const std::string& path, int width, int height, double fps, int strip_frames)

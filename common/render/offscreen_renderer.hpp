@@ -21,8 +21,9 @@ class OffscreenRenderer {
 
   // A camera following `body` (e.g. the torso) from a three-quarter view.
   void trackBody(int body, double distance, double azimuth_deg, double elevation_deg);
-  // Renders the current state; returns width*height*3 bytes, top row first.
-  const std::vector<unsigned char>& render(const mjData* data);
+  // Renders the current state, with an optional text label in the top left corner; returns
+  // width*height*3 bytes, top row first.
+  const std::vector<unsigned char>& render(const mjData* data, const std::string& label = "");
   int width() const { return width_; }
   int height() const { return height_; }
 
@@ -32,10 +33,18 @@ class OffscreenRenderer {
   void* window_ = nullptr;
   mjvScene scene_;
   mjvCamera camera_;
+  int track_body_ = -1;
   mjvOption option_;
   mjrContext context_;
   std::vector<unsigned char> rgb_, flipped_;
 };
+
+// The body a camera should follow: the one that carries the model's first free joint (a floating
+// robot's trunk), else body 1.
+int rootBody(const mjModel* model);
+// A camera distance that frames the robot (its root body's subtree, as posed in `data`), not the
+// whole scene (a 50 m beam).
+double robotViewDistance(const mjModel* model, const mjData* data);
 
 // Pipes raw RGB frames into ffmpeg. The output kind follows the file extension.
 class FrameWriter {

@@ -66,6 +66,11 @@ class Task {
   // simulator's cost from the task's, replaying the same actions along the same trajectory.
   void advancePhysics(const float* action);
   const EpisodeStats& episode() const { return episode_; }
+  // The task's own measures of how far an episode got (metres along the beam, the cube's pose
+  // error, seconds the pole stayed up), read at the end of an episode by evaluations. The names
+  // carry their units and are the same for every episode.
+  virtual std::vector<std::string> progressNames() const { return {}; }
+  virtual void progress(double* out) const {}
 
   // Whole-state symmetry: the state becomes T_i of itself (then mj_forward). The verifier compares
   // step(T s, T a) with T step(s, a).

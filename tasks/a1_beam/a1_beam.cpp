@@ -124,6 +124,17 @@ class A1Beam final : public Task {
     }
   }
 
+ public:
+  // The trunk starts at x = 0 on the beam's axis: its x is the distance walked along the beam.
+  std::vector<std::string> progressNames() const override { return {"distance_m", "speed_mps"}; }
+  void progress(double* out) const override {
+    const double x = data_->qpos[root_q_];
+    const double t = episode().length * controlTimestep();
+    out[0] = x;
+    out[1] = t > 0 ? x / t : 0.0;
+  }
+
+ protected:
   void computeRewardTerms(double* raw) const override {
     const double* q = data_->qpos + root_q_;
     const double* v = data_->qvel + root_v_;

@@ -52,6 +52,10 @@ class AntAcrobatic final : public Task {
     bindFree("ball_root", "ball", ball_);
   }
 
+ // The episode ends when the pole tilts or drops, so its length is the time the pole stayed up.
+  std::vector<std::string> progressNames() const override { return {"pole_up_s"}; }
+  void progress(double* out) const override { out[0] = episode().length * controlTimestep(); }
+
  protected:
   // The XML pose (ant on top of the ball, pole upright in the cup) with the ankles bent to
   // reset_ankle_deg, uniform joint noise (kept inside the joint ranges) and uniform velocity noise

@@ -126,6 +126,18 @@ void HumanoidDribbling::afterStep() {
   }
 }
 
+void HumanoidDribbling::progress(double* out) const {
+  double passed = 0.0;
+  for (int k = 0; k < current_; ++k) passed += length_[k];
+  const PlanarFrame& f = route_[current_];
+  const double* b = ballPos();
+  const double along = std::cos(f.heading) * (b[0] - f.x) + std::sin(f.heading) * (b[1] - f.y);
+  const double t = episode().length * controlTimestep();
+  out[0] = passed + along;
+  out[1] = current_;
+  out[2] = t > 0 ? out[0] / t : 0.0;
+}
+
 void HumanoidDribbling::transformExtras(int i) {
   if (i % 2 == 0) return;
   // The mirror y -> -y maps the route onto its mirror image: turns flip, lengths and progress keep.

@@ -20,6 +20,11 @@ class HumanoidDribbling final : public HumanoidTask {
   const PlanarFrame& segmentFrame(int k) const { return route_[k]; }
   double segmentLength(int k) const { return length_[k]; }
 
+  // How far along the route the ball got (m: whole segments passed plus the ball's along-track
+  // distance in the current one), the segments passed, and the ball's mean speed along the route.
+  std::vector<std::string> progressNames() const override { return {"route_m", "segments", "ball_speed_mps"}; }
+  void progress(double* out) const override;
+
  protected:
   void resetTask(Rng& rng) override;
   void writeObservation(float* out) const override;

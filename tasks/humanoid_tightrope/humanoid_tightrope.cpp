@@ -29,10 +29,20 @@ class HumanoidTightrope final : public HumanoidTask {
     up_threshold_ = params.number("up_threshold", 0.93);
   }
 
+  // Metres walked along the rope (+x) from the start, and the mean speed over the episode.
+  std::vector<std::string> progressNames() const override { return {"distance_m", "speed_mps"}; }
+  void progress(double* out) const override {
+    const double d = torsoPos()[0] - start_x_;
+    const double t = episode().length * controlTimestep();
+    out[0] = d;
+    out[1] = t > 0 ? d / t : 0.0;
+  }
+
  protected:
   void resetTask(Rng& rng) override {
     randomizePose(rng);
     start_z_ = standOnRope(rope_axis_z_, rope_radius_);
+    start_x_ = torsoPos()[0];
   }
 
   void writeObservation(float* out) const override {
@@ -57,12 +67,13 @@ class HumanoidTightrope final : public HumanoidTask {
 
   void copyExtrasFrom(const Task& other) override {
     start_z_ = static_cast<const HumanoidTightrope&>(other).start_z_;
+    start_x_ = static_cast<const HumanoidTightrope&>(other).start_x_;
   }
   // start_z_ is a height: invariant under the mirror, so transformExtras keeps the default.
 
  private:
   double rope_axis_z_ = 0.0, rope_radius_ = 0.0, fall_height_ = 0.0, up_threshold_ = 0.0;
-  double start_z_ = 0.0;
+  double start_z_ = 0.0, start_x_ = 0.0;  // x: along the rope, unchanged by the mirror
 };
 
 std::unique_ptr<Task> makeHumanoidTightrope(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,

@@ -158,12 +158,22 @@ class TrifingerLift final : public Task {
   bool hasSuccessMeasure() const override { return true; }
 
   bool isSuccess() const override {
+    double e[2];
+    progress(e);
+    return e[0] <= success_pos_tol_ && e[1] <= success_rot_tol_;
+  }
+
+ public:
+  // The cube's final distance to the goal (m) and its rotation angle from the goal orientation (rad).
+  std::vector<std::string> progressNames() const override { return {"position_error_m", "orientation_error_rad"}; }
+  void progress(double* out) const override {
     const double* c = data_->qpos + cube_qpos_;
     const Eigen::Quaterniond q = Eigen::Quaterniond(c[3], c[4], c[5], c[6]).normalized();
-    const double pos_err = (Eigen::Vector3d(c) - goal_pos_).norm();
-    const double rot_err = 2.0 * std::acos(std::min(1.0, std::abs(q.dot(goal_quat_))));
-    return pos_err <= success_pos_tol_ && rot_err <= success_rot_tol_;
+    out[0] = (Eigen::Vector3d(c) - goal_pos_).norm();
+    out[1] = 2.0 * std::acos(std::min(1.0, std::abs(q.dot(goal_quat_))));
   }
+
+ protected:
 
   void transformExtras(int i) override {
     goal_pos_ = sym::spatialMap(spec().group(), i) * goal_pos_;

@@ -1,0 +1,128 @@
+#include "common/policy/policy_file.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/core/config_error.hpp"
+#include "common/model/equivariance_check.hpp"
+
+namespace masa::policy {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'P', 'O', 'L', '1'};
+constexpr uint32_t kFormatVersion = 1;
+constexpr uint64_t kMaxText = 16u << 20;  // a config or spec larger than this is a corrupt file
+
+void writeText(std::ostream& os, const std::string& s) {
+  const uint64_t n = s.size();
+  os.write(reinterpret_cast<const char*>(&n), sizeof n);
+  os.write(s.data(), static_cast<std::streamsize>(n));
+}
+
+std::string readText(std::istream& is, const std::string& path, const char* what) {
+  uint64_t n = 0;
+  is.read(reinterpret_cast<char*>(&n), sizeof n);
+  if (!is || n > kMaxText) throw std::runtime_error(path + ": truncated or corrupt policy file (" + what + ")");
+  std::string s(n, '\0');
+  is.read(s.data(), static_cast<std::streamsize>(n));
+  if (!is) throw std::runtime_error(path + ": truncated policy file (" + what + ")");
+  return s;
+}
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open the symmetry spec");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+void savePolicyFile(const std::string& path, const config::RunConfig& rc, const model::ActorCritic<float>& model) {
+  const std::string spec_text = readWholeFile(rc.spec_path);
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+    if (!os) throw std::runtime_error(tmp + ": cannot write");
+    os.write(kMagic, sizeof kMagic);
+    os.write(reinterpret_cast<const char*>(&kFormatVersion), sizeof kFormatVersion);
+    writeText(os, config::dumpResolved(rc));
+    writeText(os, spec_text);
+    model.save(os);
+    os.flush();
+    if (!os) throw std::runtime_error(tmp + ": write failed");
+  }
+  fs::rename(tmp, path);
+}
+
+bool isPolicyFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[sizeof kMagic] = {};
+  in.read(magic, sizeof magic);
+  return in && std::memcmp(magic, kMagic, sizeof magic) == 0;
+}
+
+LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_dir) {
+  std::ifstream is(path, std::ios::binary);
+  if (!is) throw std::runtime_error(path + ": cannot open the policy file");
+  char magic[sizeof kMagic] = {};
+  is.read(magic, sizeof magic);
+  if (!is || std::memcmp(magic, kMagic, sizeof magic) != 0)
+    throw std::runtime_error(path + ": not a masa policy file (bad magic)");
+  uint32_t version = 0;
+  is.read(reinterpret_cast<char*>(&version), sizeof version);
+  if (!is || version != kFormatVersion)
+    throw std::runtime_error(path + ": policy file format " + std::to_string(version) + ", this masa reads " +
+                             std::to_string(kFormatVersion));
+  LoadedPolicy p;
+  p.source = path;
+  const std::string config_text = readText(is, path, "config");
+  p.spec_text = readText(is, path, "spec");
+  try {
+    p.config = config::loadRunConfigText(configs_dir, config_text, path + " (its config)");
+    p.spec = sym::SymmetrySpec::parseString(p.spec_text, path + " (its spec)");
+  } catch (const ConfigError& e) {
+    throw std::runtime_error(e.what());
+  }
+  p.model = std::make_unique<model::ActorCritic<float>>(p.spec, p.config.model);
+  p.model->load(is, path);
+  return p;
+}
+
+double checkPolicySymmetry(LoadedPolicy& policy, double tolerance, int samples) {
+  if (policy.config.method != model::Method::kMasa) return 0.0;
+  auto& model = *policy.model;
+  // Observations around the normalizer's statistics (within 2 std: the +-5 clamp of normalized
+  // inputs does not commute with rotations), actions around 0.
+  std::mt19937_64 rng(12345);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  const auto& norm = model.obsNormalizer();
+  Mat<float> obs(model.obsDim(), samples), act(model.actDim(), samples);
+  for (int b = 0; b < samples; ++b) {
+    for (int d = 0; d < model.obsDim(); ++d) {
+      const float z = std::clamp(normal(rng), -2.0f, 2.0f);
+      obs(d, b) = static_cast<float>(norm.mean()(d) + std::sqrt(norm.var()(d)) * z);
+    }
+    for (int d = 0; d < model.actDim(); ++d) act(d, b) = 0.5f * normal(rng);
+  }
+  const model::EquivarianceReport r = model::checkEquivariance<float>(model, obs, act);
+  if (!(r.worst() <= tolerance)) {
+    std::ostringstream msg;
+    msg << policy.source << ": the MASA policy is not equivariant under its spec (mean error " << r.mean_error
+        << ", log-prob " << r.logp_error << ", value " << r.value_error << ", tolerance " << tolerance
+        << "): the file does not match its spec, or is corrupt";
+    throw std::runtime_error(msg.str());
+  }
+  return r.worst();
+}
+
+}  // namespace masa::policy

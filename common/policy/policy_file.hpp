@@ -1,0 +1,40 @@
+// A trained policy as one file: what inference needs and nothing of the optimizer. It holds the
+// run's resolved configuration (task, method, model, env: the task is rebuilt exactly as trained),
+// the symmetry spec's own text (so the file works on a machine whose configs/ differ), and the
+// model (policy and critic networks, observation and value normalizers).
+//
+// Layout: "MASAPOL1", u32 format version, u64 length + config YAML, u64 length + spec YAML,
+// then ActorCritic::save(). Written atomically (tmp + rename).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "common/config/run_config.hpp"
+#include "common/model/actor_critic.hpp"
+#include "common/symmetry/symmetry_spec.hpp"
+
+namespace masa::policy {
+
+struct LoadedPolicy {
+  config::RunConfig config;
+  std::string spec_text;
+  sym::SymmetrySpec spec;
+  std::unique_ptr<model::ActorCritic<float>> model;
+  std::string source;  // the file it came from
+};
+
+void savePolicyFile(const std::string& path, const config::RunConfig& rc, const model::ActorCritic<float>& model);
+
+// Reads a policy file; throws std::runtime_error naming the file and what is wrong.
+LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_dir = config::defaultConfigsDir());
+
+// True when the file starts with the policy file's magic.
+bool isPolicyFile(const std::string& path);
+
+// The equivariance MASA guarantees, measured on random observations (normalizer, mean, std,
+// critic); throws when a MASA policy misses it by more than `tolerance`. Other methods: skipped.
+// Returns the worst relative error found (0 when skipped).
+double checkPolicySymmetry(LoadedPolicy& policy, double tolerance = 1e-4, int samples = 64);
+
+}  // namespace masa::policy

@@ -1,0 +1,88 @@
+#include "learner/checkpoint.hpp"
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace masa::learner {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'C', 'K', 'P', '1'};
+
+template <class T>
+void writePod(std::ostream& os, const T& v) {
+  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+template <class T>
+T readPod(std::istream& is, const std::string& path) {
+  T v{};
+  is.read(reinterpret_cast<char*>(&v), sizeof(T));
+  if (!is) throw std::runtime_error(path + ": truncated checkpoint");
+  return v;
+}
+
+}  // namespace
+
+void writeCheckpoint(const std::string& path, const CheckpointState& s, const model::ActorCritic<float>& model,
+                     const nn::Adam<float>& adam) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+    os.write(kMagic, sizeof kMagic);
+    writePod(os, s.run_id);
+    writePod(os, s.updates);
+    writePod(os, s.version);
+    writePod(os, s.env_steps);
+    writePod(os, s.wall_time_s);
+    writePod(os, s.lr);
+    writePod(os, static_cast<uint64_t>(s.rng_state.size()));
+    os.write(s.rng_state.data(), static_cast<std::streamsize>(s.rng_state.size()));
+    writePod(os, static_cast<uint64_t>(s.order.size()));
+    os.write(reinterpret_cast<const char*>(s.order.data()), static_cast<std::streamsize>(s.order.size() * sizeof(int)));
+    model.save(os);
+    adam.save(os);
+    os.flush();
+    if (!os) throw std::runtime_error("checkpoint: cannot write " + tmp);
+  }
+  fs::rename(tmp, path);  // atomic on POSIX: a crash leaves the old or the new checkpoint, never half
+}
+
+bool isCheckpointFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[sizeof kMagic] = {};
+  in.read(magic, sizeof magic);
+  return in && std::memcmp(magic, kMagic, sizeof magic) == 0;
+}
+
+CheckpointState readCheckpoint(const std::string& path, model::ActorCritic<float>& model, nn::Adam<float>* adam) {
+  std::ifstream is(path, std::ios::binary);
+  if (!is) throw std::runtime_error(path + ": cannot open the checkpoint");
+  char magic[sizeof kMagic];
+  is.read(magic, sizeof magic);
+  if (!is || std::memcmp(magic, kMagic, sizeof magic) != 0)
+    throw std::runtime_error(path + ": not a masa learner checkpoint (bad magic)");
+  CheckpointState s;
+  s.run_id = readPod<int64_t>(is, path);
+  s.updates = readPod<int64_t>(is, path);
+  s.version = readPod<int64_t>(is, path);
+  s.env_steps = readPod<int64_t>(is, path);
+  s.wall_time_s = readPod<double>(is, path);
+  s.lr = readPod<double>(is, path);
+  const uint64_t rn = readPod<uint64_t>(is, path);
+  if (rn > (1u << 20)) throw std::runtime_error(path + ": corrupt rng state");
+  s.rng_state.assign(rn, '\0');
+  is.read(s.rng_state.data(), static_cast<std::streamsize>(rn));
+  const uint64_t on = readPod<uint64_t>(is, path);
+  if (on > (1ull << 31)) throw std::runtime_error(path + ": corrupt shuffle order");
+  s.order.resize(on);
+  is.read(reinterpret_cast<char*>(s.order.data()), static_cast<std::streamsize>(on * sizeof(int)));
+  if (!is) throw std::runtime_error(path + ": truncated checkpoint");
+  model.load(is, path);
+  if (adam) adam->load(is);
+  return s;
+}
+
+}  // namespace masa::learner
