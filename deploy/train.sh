@@ -4,6 +4,8 @@
 # and talking over LAN multicast (udpm, ttl=1). Ctrl-C stops everything cleanly, remote actors
 # included; the learner checkpoints, so the run directory is resumable.
 #   deploy/train.sh [task] [method] [--actors K] [--envs E] [--updates N] [--set key=value ...]
+#   deploy/train.sh --recipe NAME [--actors K] [--run-dir DIR] ...   (configs/recipes/NAME.yaml: its task,
+#                   method, batch and ppo.max_epochs updates; its environments split over the actors)
 #   deploy/train.sh [task] [method] --hosts FILE [--envs E] [--updates N] [--set key=value ...]
 #   deploy/train.sh --resume RUN_DIR [--actors K] [--envs E] [--updates N]   (N counts all updates)
 # FILE has one host per line, "host [actors] [envs]" (default 1 actor of E environments), '#'
@@ -20,16 +22,18 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-task=a1_beam method=masa
-[ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; shift; }
-[ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; shift; }
-actors=2 envs=32 updates=200 hosts_file="" actors_given=0 resume=""
+task=a1_beam method=masa task_given=0 method_given=0
+[ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; task_given=1; shift; }
+[ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; method_given=1; shift; }
+actors=2 envs=32 envs_given=0 updates="" hosts_file="" actors_given=0 resume="" recipe="" run_dir_given=""
 sets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --resume) resume=$2; shift 2 ;;
     --actors) actors=$2; actors_given=1; shift 2 ;;
-    --envs) envs=$2; shift 2 ;;
+    --envs) envs=$2; envs_given=1; shift 2 ;;
+    --recipe) recipe=$2; shift 2 ;;
+    --run-dir) run_dir_given=$2; shift 2 ;;
     --updates) updates=$2; shift 2 ;;
     --hosts) hosts_file=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
@@ -38,9 +42,28 @@ while [ $# -gt 0 ]; do
 done
 
 build=${MASA_BUILD_DIR:-build}
-for bin in "$build/learner/masa_learner" "$build/actors/masa_actor"; do
+for bin in "$build/learner/masa_learner" "$build/actors/masa_actor" "$build/tools/masa_config"; do
   [ -x "$bin" ] || { echo "train.sh: $bin is missing: run deploy/build.sh first" >&2; exit 2; }
 done
+
+# A recipe names the task, the method, the batch and the run's length; what the command line
+# gives (task, method, --envs, --updates, --set) still wins.
+if [ -n "$recipe" ]; then
+  [ -z "$resume" ] || { echo "train.sh: --recipe starts a run; --resume goes on with the run's own config" >&2; exit 2; }
+  resolved=$("$build/tools/masa_config" --set "@$recipe" "${sets[@]+"${sets[@]}"}") || exit 2
+  [ "$task_given" = 1 ] || task=$(sed -n 's/^task: //p' <<< "$resolved")
+  [ "$method_given" = 1 ] || method=$(sed -n 's/^method: //p' <<< "$resolved")
+  recipe_envs=$(sed -n 's/^  num_envs: //p' <<< "$resolved")
+  [ -n "$updates" ] || updates=$(sed -n 's/^  max_epochs: //p' <<< "$resolved")
+  if [ "$envs_given" = 0 ] && [ -z "$hosts_file" ]; then
+    if (( recipe_envs % actors != 0 )); then
+      echo "train.sh: recipe $recipe has $recipe_envs environments, not divisible over $actors actors (give --envs)" >&2
+      exit 2
+    fi
+    envs=$((recipe_envs / actors))
+  fi
+fi
+updates=${updates:-200}
 
 # Actor placement: host, actor count and environments per actor, one entry per hosts-file line.
 hosts=() host_actors=() host_envs=()
@@ -89,14 +112,19 @@ if [ -n "$resume" ]; then
   task=$(sed -n 's/^task: //p' "$run_dir/config.yaml") method=$(sed -n 's/^method: //p' "$run_dir/config.yaml")
 else
   run_id=$(( ($(date +%s%N) / 1000) % 2000000000 + 1 ))
-  run_dir="${MASA_RUNS_DIR:-runs}/${task}_${method}_$(date +%Y%m%d_%H%M%S)"
+  run_dir=${run_dir_given:-"${MASA_RUNS_DIR:-runs}/${task}_${method}_$(date +%Y%m%d_%H%M%S)"}
   mkdir -p "$run_dir"
   echo "$run_id" > "$run_dir/run_id"
   learner_run=(--run-dir "$run_dir")
   actor_config=()
-  # Sized for a 2-core machine; the paper's batches (4096 envs x 32 steps, minibatch 32768) are GPU-scale.
-  common=(--set task="$task" --set method="$method" --set "ppo.num_envs=$total_envs"
-          --set ppo.horizon=32 --set ppo.minibatch_size=1024 "${sets[@]+"${sets[@]}"}")
+  if [ -n "$recipe" ]; then
+    common=(--set "@$recipe" --set task="$task" --set method="$method" --set "ppo.num_envs=$total_envs"
+            "${sets[@]+"${sets[@]}"}")
+  else
+    # Sized for a 2-core machine; the paper's batches (4096 envs x 32 steps, minibatch 32768) are GPU-scale.
+    common=(--set task="$task" --set method="$method" --set "ppo.num_envs=$total_envs"
+            --set ppo.horizon=32 --set ppo.minibatch_size=1024 "${sets[@]+"${sets[@]}"}")
+  fi
 fi
 
 if [ -z "$hosts_file" ]; then
