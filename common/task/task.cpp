@@ -20,6 +20,7 @@ Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::Symm
   max_episode_steps_ = params.integer("max_episode_steps", 1000, 1);
   termination_reward_ = params.number("termination_reward", -1.0);
   energy_velocity_scale_ = params.number("energy_velocity_scale", 0.2);
+  energy_effort_weighting_ = params.flag("energy_effort_weighting", false);
   for (const auto& [term, w] : terms_with_default_weights) {
     term_names_.push_back(term);
     weights_.push_back(params.weight(term, w));
@@ -29,6 +30,16 @@ Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::Symm
   raw_terms_.assign(term_names_.size(), 0.0);
   data_ = mj_makeData(model_->get());
   bindActuators();
+  // IsaacGymEnvs' Humanoid weighs each joint's electricity cost by its motor's share of the
+  // strongest motor (gear / max gear); its Ant does not.
+  effort_ratio_.assign(actDim(), 1.0);
+  if (energy_effort_weighting_) {
+    const mjModel* m = model_->get();
+    double max_gear = 0.0;
+    for (int k = 0; k < actDim(); ++k) max_gear = std::max(max_gear, std::abs(m->actuator_gear[6 * action_actuator_[k]]));
+    for (int k = 0; k < actDim(); ++k)
+      effort_ratio_[k] = max_gear > 0 ? std::abs(m->actuator_gear[6 * action_actuator_[k]]) / max_gear : 1.0;
+  }
   last_action_.assign(actDim(), 0.0);
   action_scratch_.assign(actDim(), 0.0);
   qpos_scratch_.assign(model_->get()->nq, 0.0);
@@ -148,7 +159,7 @@ double Task::jointPower() const {
   double p = 0.0;
   for (int k = 0; k < actDim(); ++k) {
     const int j = action_joint_[k];
-    if (j >= 0) p += std::abs(last_action_[k] * data_->qvel[m->jnt_dofadr[j]]);
+    if (j >= 0) p += std::abs(last_action_[k] * data_->qvel[m->jnt_dofadr[j]]) * effort_ratio_[k];
   }
   return p * energy_velocity_scale_;
 }

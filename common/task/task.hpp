@@ -115,9 +115,11 @@ class Task {
   int jointOfAction(int k) const { return action_joint_[k]; }
   int frameSkip() const { return frame_skip_; }
   // The paper's "joints power consumption" in the convention its weights were tuned for
-  // (IsaacGym's electricity cost): sum over actions of |a_k * qdot_k| * energy_velocity_scale, with
-  // a_k the clamped action in [-1, 1] and qdot_k its joint's velocity (rad/s). Physical power
-  // |torque * qdot| would be gear times larger and swamp the other terms at the paper's weights.
+  // (IsaacGym's electricity cost): sum over actions of |a_k * qdot_k| * energy_velocity_scale * w_k,
+  // with a_k the clamped action in [-1, 1], qdot_k its joint's velocity (rad/s), and w_k = 1 (the
+  // Ant's convention) or, with env.energy_effort_weighting, the motor's gear over the largest gear
+  // (the Humanoid's). Physical power |torque * qdot| would be gear times larger and swamp the
+  // other terms at the paper's weights.
   double jointPower() const;
 
   std::shared_ptr<const MujocoModel> model_;
@@ -134,6 +136,8 @@ class Task {
   int max_episode_steps_;
   double termination_reward_;
   double energy_velocity_scale_;
+  bool energy_effort_weighting_ = false;
+  std::vector<double> effort_ratio_;  // per action: gear / max gear, or 1
   std::vector<std::string> term_names_;
   std::vector<double> weights_;
   std::vector<double> terms_, raw_terms_;

@@ -6,6 +6,11 @@
 //   A_t = delta_t + gamma lambda A_(t+1), the recursion cut at terminated and truncated steps:
 //   the next row of a truncated env is already the next episode.
 // A step flagged both terminated and truncated counts as terminated. Values are in real units.
+//
+// Deliberately unlike rl_games: on a time-out rl_games adds gamma * V(s_t) (the value of the
+// observation BEFORE the step, the only one it keeps) to the reward. We bootstrap from the value
+// of the true final observation the actor sends with the step, which is what the truncated
+// return's tail actually is; the two agree only when V changes little in one step.
 #pragma once
 
 #include "common/core/types.hpp"

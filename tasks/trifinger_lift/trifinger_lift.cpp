@@ -25,7 +25,7 @@ constexpr int kJoints = 9;
 class TrifingerLift final : public Task {
  public:
   TrifingerLift(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec, EnvParams& p)
-      : Task("trifinger_lift", std::move(model), spec, p, {{"keypoints", 40.0}, {"reach", -15.0}}) {
+      : Task("trifinger_lift", std::move(model), spec, p, {{"keypoints", 40.0}, {"reach", -250.0}}) {
     kp_ = p.positive("kp", 10.0);
     kd_ = p.number("kd", 0.2);
     max_velocity_ = p.positive("max_joint_velocity", 10.0);

@@ -197,14 +197,21 @@ TEST(HumanoidTightropeTask, ActionAndEnergyCostsFollowTheAppendix) {
   a[0] = 3.0f;  // clamped to 1
   t->step(a.data());
   EXPECT_NEAR(rewardTerm(*t, "action"), -0.01 * (1.0 + 20 * 0.25), 1e-12);
-  // Energy: -0.05 * 0.2 * sum_k |a_k * qdot_k| over the actuated joints (Task::jointPower: the
-  // electricity-cost convention the paper's weights were tuned for).
+  // Energy: -0.05 * 0.1 * sum_k |a_k * qdot_k| * gear_k / max gear over the actuated joints
+  // (Task::jointPower: IsaacGymEnvs' Humanoid electricity cost, which the paper's weights were
+  // tuned for; the Ant's is 0.2 and unweighted).
   const mjModel* m = t->model();
+  double max_gear = 0.0;
+  for (int k = 0; k < m->nu; ++k) max_gear = std::max(max_gear, m->actuator_gear[6 * k]);
   double power = 0.0;
+  bool unequal_gears = false;
   for (int k = 0; k < m->nu; ++k) {
     const int j = m->actuator_trnid[2 * k];
-    power += 0.2 * std::abs(t->data()->ctrl[k] * t->data()->qvel[m->jnt_dofadr[j]]);
+    const double ratio = m->actuator_gear[6 * k] / max_gear;
+    unequal_gears |= ratio < 0.99;
+    power += 0.1 * std::abs(t->data()->ctrl[k] * t->data()->qvel[m->jnt_dofadr[j]]) * ratio;
   }
+  EXPECT_TRUE(unequal_gears);  // otherwise the weighting would not be tested
   EXPECT_GT(power, 0.0);
   EXPECT_NEAR(rewardTerm(*t, "energy"), -0.05 * power, 1e-12);
 }

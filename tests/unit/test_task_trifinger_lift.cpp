@@ -119,7 +119,7 @@ TEST(TrifingerLift, ReachTermRewardsTheDecreaseOfFingertipToCubeDistance) {
   const double after = tipDistanceSum(*t);
   EXPECT_LT(after, before);
   const double reach = rewardTerm(*t, "reach");
-  EXPECT_NEAR(reach, -15.0 * (after - before), 1e-12);
+  EXPECT_NEAR(reach, -250.0 * (after - before), 1e-12);  // IsaacGymEnvs' weight, not scaled by dt
   EXPECT_GT(reach, 0.0);
 }
 
