@@ -21,5 +21,26 @@ cp "$run/config.yaml" "$run/metrics.csv" "$out/"
   | grep -v '^wrote' > "$out/eval.txt"
 xvfb-run -a "$build/tools/masa_eval" "$out/policy.bin" --episodes 1 --video "$out/strip.png" --width 400 --height 300 > /dev/null
 updates=$(tail -n 1 "$run/metrics.csv" | cut -d, -f1) steps=$(tail -n 1 "$run/metrics.csv" | cut -d, -f3)
+wall=$(tail -n 1 "$run/metrics.csv" | cut -d, -f4)
+# policy/README.md: what was shipped, how it was made, and how it does.
+{
+  echo "# $task: shipped policy"
+  echo
+  echo "Trained $(date +%Y-%m-%d) from commit $(git rev-parse --short HEAD) on $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')):"
+  echo "$((updates + 1)) updates, $steps env steps, $(printf %.0f "$wall") s of training wall time. Run configuration: \`config.yaml\`."
+  echo
+  echo '```bash'
+  echo "build/tools/masa_eval tasks/$task/policy/policy.bin --episodes $episodes      # the table below"
+  echo "xvfb-run -a build/tools/masa_eval tasks/$task/policy/policy.bin --video $task.mp4"
+  echo '```'
+  echo
+  grep '^|' "$out/eval.txt"
+  echo
+  grep -v '^|' "$out/eval.txt" | grep -v '^equivariance\|^'"$task"' /' || true
+  echo
+  echo '![strip of evaluation episode 0](strip.png)'
+  echo
+  echo '![learning curve](learning_curve.png)'
+} > "$out/README.md"
 echo "shipped $run as $out: $((updates + 1)) updates, $steps env steps, $(du -h "$out/policy.bin" | cut -f1) policy"
 cat "$out/eval.txt"

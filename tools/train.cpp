@@ -7,6 +7,7 @@
 // metrics, checkpoint, learning curve).
 //   masa_train --set task=a1_beam --set method=sa --updates 50 --run-dir runs/a1_sa
 //   masa_train --recipe a1_beam --threads 2     (configs/recipes/a1_beam.yaml, its ppo.max_epochs updates)
+//   masa_train --resume runs/x --updates 1200   (go on to 1200 updates in total, from its checkpoint)
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
@@ -31,7 +32,7 @@ int main(int argc, char** argv) {
   std::string configs = masa::config::defaultConfigsDir();
   std::string run_dir;
   int64_t updates = 0;
-  std::string recipe;
+  std::string recipe, resume;
   int threads = 1;
   bool quiet = false;
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set task=a1_beam");
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--threads", threads, "OpenMP threads over the environments")->capture_default_str()
       ->check(CLI::Range(1, 1024));
+  app.add_option("--resume", resume, "go on with the run in this directory (its config.yaml and checkpoint.bin)");
   app.add_flag("--quiet", quiet, "no progress line per update");
   CLI11_PARSE(app, argc, argv);
 
@@ -49,7 +51,12 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, onSignal);
   try {
     if (!recipe.empty()) overrides.insert(overrides.begin(), "@" + recipe);
-    const auto rc = masa::config::loadRunConfig(configs, overrides);
+    if (!resume.empty()) {
+      if (!recipe.empty()) throw std::runtime_error("--resume goes on with the run's own config: no --recipe");
+      if (!run_dir.empty() && run_dir != resume) throw std::runtime_error("--resume names the run directory: no --run-dir");
+      run_dir = resume;
+    }
+    const auto rc = masa::config::loadRunConfig(configs, overrides, resume.empty() ? "" : resume + "/config.yaml");
     if (updates == 0) updates = rc.ppo.max_epochs;
     if (run_dir.empty())
       run_dir = "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" + std::to_string(rc.seed) +
@@ -59,6 +66,7 @@ int main(int argc, char** argv) {
     lo.run_dir = run_dir;
     lo.run_id = 1;
     lo.verbose = !quiet;
+    lo.resume = !resume.empty();
     masa::learner::Learner learner(rc, lo);
     learner.setMaxUpdates(updates);
 
