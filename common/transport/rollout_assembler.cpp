@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "common/core/check.hpp"
-#include "common/transport/chunk_wire_guard.hpp"
+#include "common/transport/wire_guard.hpp"
 
 namespace masa::transport {
 
@@ -278,15 +278,8 @@ Verdict RolloutAssembler::accept(const masa::lcmt_rollout_chunk& msg) {
 }
 
 Verdict RolloutAssembler::acceptEncoded(const void* data, int size) {
-  if (!chunkWireLengthsFit(data, size)) return finish(DropReason::kMalformed, nullptr);
   clearArrays(decoded_);
-  int used = -1;
-  try {
-    used = decoded_.decode(data, 0, size);
-  } catch (const std::exception&) {  // bad_alloc / length_error: cannot happen after the guard
-    used = -1;
-  }
-  if (used != size) return finish(DropReason::kMalformed, nullptr);
+  if (decodeChecked(data, size, decoded_) != WireVerdict::kOk) return finish(DropReason::kMalformed, nullptr);
   return accept(decoded_);
 }
 
