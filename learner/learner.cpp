@@ -14,6 +14,7 @@
 #include "common/policy/policy_file.hpp"
 #include "common/task/policy_evaluator.hpp"
 #include "learner/checkpoint.hpp"
+#include "learner/metrics_csv.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/drop_reason.hpp"
@@ -407,6 +408,7 @@ void Learner::loadCheckpoint() {
   rng_text >> rng_;
   if (!rng_text) throw std::runtime_error("resume: corrupt rng state in " + dir_ + "/checkpoint.bin");
   restored_order_ = s.order;
+  truncateMetricsCsv((fs::path(dir_) / "metrics.csv").string(), s.updates);  // rows past the checkpoint come again
   trainer_->learningRate().setLr(s.lr);
   adam_->config().lr = static_cast<float>(s.lr);
 }
