@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -191,7 +192,24 @@ TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTri
   EXPECT_EQ(countOf("wrong_run"), foreign);
   EXPECT_EQ(countOf("malformed"), 1);
   EXPECT_EQ(countOf("non_finite"), nan_chunks);
-  EXPECT_EQ(learner.droppedTotal(), foreign + 1 + nan_chunks);
+  EXPECT_EQ(learner.droppedChunks(), foreign + 1 + nan_chunks);
+  EXPECT_EQ(learner.droppedEnvs(), 0);
+  // metrics.csv: chunks and environments in columns of their own, never added together.
+  const auto lines = readLines(dir / "metrics.csv");
+  ASSERT_EQ(lines.size(), 2u);
+  auto cell = [&](const std::string& column) {
+    std::vector<std::string> head, row;
+    for (auto [line, out] : {std::pair{&lines[0], &head}, std::pair{&lines[1], &row}}) {
+      std::stringstream ss(*line);
+      for (std::string f; std::getline(ss, f, ',');) out->push_back(f);
+    }
+    for (std::size_t i = 0; i < head.size() && i < row.size(); ++i)
+      if (head[i] == column) return row[i];
+    return std::string("(no column ") + column + ")";
+  };
+  EXPECT_EQ(cell("dropped_chunks"), std::to_string(foreign + 1 + nan_chunks));
+  EXPECT_EQ(cell("dropped_envs"), "0");
+  EXPECT_EQ(cell("dropped"), "(no column dropped)");
   fs::remove_all(dir);
 }
 
