@@ -8,7 +8,6 @@
 #include <stdexcept>
 
 #include "common/core/check.hpp"
-#include "common/transport/wire_guard.hpp"
 
 namespace masa::transport {
 
@@ -355,7 +354,11 @@ Verdict RolloutAssembler::accept(const masa::lcmt_rollout_chunk& msg) {
 
 Verdict RolloutAssembler::acceptEncoded(const void* data, int size) {
   clearArrays(decoded_);
-  if (decodeChecked(data, size, decoded_) != WireVerdict::kOk) return finish(DropReason::kMalformed, nullptr);
+  const WireVerdict wire = decodeChecked(data, size, decoded_);
+  if (wire != WireVerdict::kOk) {
+    ++wire_rejects_[static_cast<int>(wire)];
+    return finish(DropReason::kMalformed, nullptr);
+  }
   return accept(decoded_);
 }
 

@@ -36,9 +36,6 @@ int64_t wallClockMicros();
 // (about 15% of them in a 2-actor run on this machine); 2048 chunks of 60 KB are about 120 MB.
 inline constexpr int kSubscriptionQueueCapacity = 2048;
 
-// Messages rejected on one channel, per WireVerdict (the kOk entry stays 0).
-using WireRejects = std::array<int64_t, kNumWireVerdicts>;
-
 class Transport {
  public:
   using RawHandler = std::function<void(const void* data, int size)>;

@@ -36,6 +36,9 @@ enum class WireVerdict : int {
 inline constexpr int kNumWireVerdicts = static_cast<int>(WireVerdict::kCount);
 std::string_view wireVerdictName(WireVerdict v);
 
+// Messages rejected on one channel, per WireVerdict (the kOk entry stays 0).
+using WireRejects = std::array<int64_t, kNumWireVerdicts>;
+
 // Sane maxima, far above what masa sends (the largest policy is about 10^5 floats, names are short)
 // and low enough that no length can make a decoder allocate more than a few hundred MB.
 struct WireLimits {

@@ -369,6 +369,10 @@ TEST(RolloutAssembler, MalformedBytesAreDroppedWithoutDecodingHostileLengths) {
             DropReason::kMalformed);
   EXPECT_EQ(assembler.acceptEncoded(nullptr, 0).reason, DropReason::kMalformed);
   EXPECT_EQ(assembler.stats()[DropReason::kMalformed], 4);
+  // And why, by the wire guard's reasons.
+  EXPECT_EQ(assembler.wireRejects()[static_cast<int>(WireVerdict::kTruncated)], 2);  // the cut and nullptr
+  EXPECT_EQ(assembler.wireRejects()[static_cast<int>(WireVerdict::kOverLimit)], 1);
+  EXPECT_EQ(assembler.wireRejects()[static_cast<int>(WireVerdict::kNegativeLength)], 1);
   // The intact bytes decode and pass, even after a chunk with empty arrays was decoded into the
   // same reused message (the generated decoder leaves zero-length arrays untouched).
   EXPECT_TRUE(assembler.acceptEncoded(bytes.data(), static_cast<int>(bytes.size())));
