@@ -110,13 +110,10 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
   if (m.run_id != options_.run_id) return;  // another run on the same network
   const int64_t newest = std::max(version_, pending_version_);
   if (m.version <= newest) return;  // the learner repeats its latest parameters periodically
-  if (m.version <= last_rejected_version_) return;  // warned already: the learner repeats it
-  auto reject = [&](const std::string& why) {
-    ++params_rejected_;
-    last_rejected_version_ = m.version;
-    std::fprintf(stderr, "masa_actor %d: ignoring parameters version %lld: %s\n", options_.actor_id,
-                 static_cast<long long>(m.version), why.c_str());
-  };
+  auto reject = [&](const std::string& why) { rejectParams(m.version, why); };
+  if (m.version - std::max<int64_t>(newest, 0) > options_.max_version_step)
+    return reject("more than " + std::to_string(options_.max_version_step) + " versions ahead of " +
+                  std::to_string(std::max<int64_t>(newest, 0)));
   if (m.task != config_.task) return reject("task '" + m.task + "', this actor runs '" + config_.task + "'");
   if (m.method != model::methodName(config_.method))
     return reject("method '" + m.method + "', this actor builds '" + model::methodName(config_.method) + "'");
@@ -143,6 +140,18 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
   }
   pending_version_ = m.version;
   pending_has_norm_ = m.obs_dim > 0;
+}
+
+void Actor::rejectParams(int64_t version, const std::string& why) {
+  ++params_rejected_;
+  ++rejects_since_warning_;
+  const double now = nowSeconds();
+  if (now - last_reject_warning_s_ < options_.reject_warning_interval_s) return;
+  std::fprintf(stderr, "masa_actor %d: ignoring parameters version %lld: %s (%lld rejected since the last such line)\n",
+               options_.actor_id, static_cast<long long>(version), why.c_str(),
+               static_cast<long long>(rejects_since_warning_));
+  last_reject_warning_s_ = now;
+  rejects_since_warning_ = 0;
 }
 
 void Actor::swapInPending() {

@@ -54,6 +54,13 @@ struct ActorOptions {
   // max_policy_lag 0, a third of the data in a 2-actor run). Bounded, so that a batch still fills
   // when another actor is dead (at the cost of this wait per update). 0: never wait.
   double await_params_s = 1.0;
+  // Parameters are believed only as plausible steps: a version more than this far ahead of the
+  // actor's (of 0 before the first) is rejected. No run makes a million updates; a forged or fuzzed
+  // version (2^51) would otherwise make the actor ignore every real update after it.
+  int64_t max_version_step = 1'000'000;
+  // Rejected parameter messages are warned about at most once per this interval (the learner
+  // repeats its parameters, so a mismatch would otherwise print a line per repetition).
+  double reject_warning_interval_s = 5.0;
   const std::atomic<bool>* stop = nullptr;  // checked between steps (signal handlers set it)
   // Test hook: called after each step t of a rollout (rollout_index counts this actor's rollouts
   // from 0, whatever first_rollout_seq is), before incoming messages are handled.
@@ -94,6 +101,7 @@ class Actor {
 
  private:
   void onParams(const masa::lcmt_policy_params& msg);
+  void rejectParams(int64_t version, const std::string& why);
   void swapInPending();
   bool stopRequested() const { return options_.stop && options_.stop->load(std::memory_order_relaxed); }
   void maybeHeartbeat();
@@ -129,8 +137,10 @@ class Actor {
   std::vector<float> pending_params_, pending_mean_, pending_std_;
   int pending_count_ = 0;
   bool pending_has_norm_ = false;
+  // Nothing of a rejected message is kept but these counts: it cannot change what comes after it.
   int64_t params_rejected_ = 0;
-  int64_t last_rejected_version_ = -1;
+  int64_t rejects_since_warning_ = 0;
+  double last_reject_warning_s_ = -1e300;
 
   int64_t rollouts_sent_ = 0;
   int64_t first_rollout_seq_ = 0;

@@ -14,6 +14,7 @@
 #include "common/policy/policy_file.hpp"
 #include "common/task/policy_evaluator.hpp"
 #include "learner/checkpoint.hpp"
+#include "learner/metrics_csv.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/drop_reason.hpp"
@@ -115,10 +116,10 @@ double Learner::wallTime() const {
   return wall_offset_s_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-int64_t Learner::droppedTotal() const {
-  int64_t n = assembler_->stats().dropped();
-  if (collector_) n += collector_->stats().envs_stale + collector_->stats().envs_overflow;
-  return n;
+int64_t Learner::droppedChunks() const { return assembler_->stats().dropped(); }
+
+int64_t Learner::droppedEnvs() const {
+  return collector_ ? collector_->stats().envs_stale + collector_->stats().envs_overflow : 0;
 }
 
 void Learner::onChunk(const void* data, int size) {
@@ -244,7 +245,8 @@ void Learner::update(const transport::RolloutBatch& batch) {
   // The first interval includes start-up; later ones weigh in with a short memory.
   update_interval_s_ = epoch_ <= 2 ? dt : 0.8 * update_interval_s_ + 0.2 * dt;
   summarizeEpisodes(batch.data);
-  report_.dropped = droppedTotal();
+  report_.dropped_chunks = droppedChunks();
+  report_.dropped_envs = droppedEnvs();
   report_.eval_return = report_.eval_length = report_.eval_success = std::nan("");
   report_.eval_progress.assign(eval_progress_names_.size(), std::nan(""));
   if (eval_factory_ && epoch_ % rc_.runner.eval_every == 0) evaluate();
@@ -269,10 +271,10 @@ void Learner::update(const transport::RolloutBatch& batch) {
     char success[32] = "";  // only for tasks with a success notion
     if (report_.success_rate >= 0) std::snprintf(success, sizeof(success), "  success %.2f", report_.success_rate);
     std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f%s  kl %.5f  lr %.2e  "
-                "actor %.4f  critic %.4f  dropped %lld%s\n",
+                "actor %.4f  critic %.4f  dropped %lld chunks %lld envs%s\n",
                 static_cast<long long>(epoch_), total, static_cast<long long>(env_steps_), report_.fps,
                 report_.mean_return, report_.mean_length, success, report_.ppo.kl, report_.ppo.lr,
-                report_.ppo.actor_loss, report_.ppo.critic_loss, static_cast<long long>(report_.dropped), eta);
+                report_.ppo.actor_loss, report_.ppo.critic_loss, static_cast<long long>(report_.dropped_chunks), static_cast<long long>(report_.dropped_envs), eta);
     if (!std::isnan(report_.eval_return)) {
       std::printf("  eval (policy mean, %d episodes): return %.3f  len %.1f", rc_.runner.eval_episodes,
                   report_.eval_return, report_.eval_length);
@@ -361,7 +363,7 @@ void Learner::appendCsv() {
     f << "epoch,version,env_steps,wall_time_s,fps,return,length,success";
     if (collector_)
       for (const auto& t : collector_->config().term_names) f << ",term_" << t;
-    f << ",actor_loss,critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped";
+    f << ",actor_loss,critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped_chunks,dropped_envs";
     f << ",eval_return,eval_length,eval_success";
     for (const auto& n : eval_progress_names_) f << ",eval_" << n;
     f << '\n';
@@ -373,7 +375,7 @@ void Learner::appendCsv() {
   for (double t : report_.term_means) f << ',' << t;
   f << ',' << p.actor_loss << ',' << p.critic_loss << ',' << p.entropy << ',' << p.bounds_loss << ','
     << p.sym_policy_loss << ',' << p.sym_value_loss << ',' << p.kl << ',' << p.lr << ',' << p.grad_norm << ','
-    << p.explained_variance << ',' << report_.dropped;
+    << p.explained_variance << ',' << report_.dropped_chunks << ',' << report_.dropped_envs;
   f << ',' << report_.eval_return << ',' << report_.eval_length << ',' << report_.eval_success;
   for (double v : report_.eval_progress) f << ',' << v;
   f << '\n';
@@ -407,6 +409,7 @@ void Learner::loadCheckpoint() {
   rng_text >> rng_;
   if (!rng_text) throw std::runtime_error("resume: corrupt rng state in " + dir_ + "/checkpoint.bin");
   restored_order_ = s.order;
+  truncateMetricsCsv((fs::path(dir_) / "metrics.csv").string(), s.updates);  // rows past the checkpoint come again
   trainer_->learningRate().setLr(s.lr);
   adam_->config().lr = static_cast<float>(s.lr);
 }

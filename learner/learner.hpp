@@ -48,7 +48,8 @@ struct UpdateReport {
   double mean_return = 0, mean_length = 0, success_rate = -1;
   std::vector<double> term_means;
   ppo::PpoStats ppo;
-  int64_t dropped = 0;
+  int64_t dropped_chunks = 0;  // by the assembler, every reason (lost included), since the run began
+  int64_t dropped_envs = 0;    // by the collector (stale, overflow), since the run began
   // The policy mean's evaluation (runner.eval_every): NaN in updates without one.
   double eval_return = std::nan(""), eval_length = std::nan(""), eval_success = std::nan("");
   std::vector<double> eval_progress;  // the task's progress figures (Task::progressNames)
@@ -84,8 +85,10 @@ class Learner {
   const std::string& runDir() const { return dir_; }
   const model::ActorCritic<float>& model() const { return *model_; }
   const transport::DropStats& dropStats() const { return assembler_->stats(); }
-  // Chunks dropped by the assembler plus environments dropped by the collector.
-  int64_t droppedTotal() const;
+  // One unit each: rollout chunks the assembler dropped (or counted lost), and environments the
+  // collector dropped (stale or overflowing its pool).
+  int64_t droppedChunks() const;
+  int64_t droppedEnvs() const;
   const UpdateReport& lastReport() const { return report_; }
 
  private:

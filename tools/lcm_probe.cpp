@@ -25,6 +25,7 @@
 #include "common/transport/channels.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/transport.hpp"
+#include "common/transport/wire_guard.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 #include "masa/lcmt_learner_stats.hpp"
 #include "masa/lcmt_policy_params.hpp"
@@ -44,13 +45,11 @@ struct Stamp {
   int64_t version = -1;
 };
 
+// Through the wire guard, as every masa process decodes: the probe listens to hostile LANs too.
 template <class Msg>
 std::optional<Msg> decodeAs(const void* data, int size) {
   Msg m;
-  try {
-    if (m.decode(data, 0, size) == size) return m;
-  } catch (const std::exception&) {
-  }
+  if (transport::decodeChecked(data, size, m) == transport::WireVerdict::kOk) return m;
   return std::nullopt;
 }
 

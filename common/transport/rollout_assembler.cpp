@@ -8,7 +8,6 @@
 #include <stdexcept>
 
 #include "common/core/check.hpp"
-#include "common/transport/chunk_wire_guard.hpp"
 
 namespace masa::transport {
 
@@ -183,51 +182,127 @@ void RolloutAssembler::startNumbering(ActorWindow& a, int actor_id, int64_t seq)
   ++a.tally.numberings;
 }
 
-DropReason RolloutAssembler::markSeen(const masa::lcmt_rollout_chunk& m, bool accepted) {
-  if (static_cast<int>(actors_.size()) <= m.actor_id) actors_.resize(m.actor_id + 1);
-  ActorWindow& a = actors_[m.actor_id];
-  if (a.rollouts.empty()) a.rollouts.resize(cfg_.dedup_window);
-  const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
+RolloutAssembler::ActorWindow& RolloutAssembler::windowOf(int actor_id) {
+  if (static_cast<int>(actors_.size()) <= actor_id) actors_.resize(actor_id + 1);
+  ActorWindow& a = actors_[actor_id];
+  // Twice the window: rollouts up to dedup_window behind the newest, and out-of-date arrivals up
+  // to dedup_window ahead of it.
+  if (a.rollouts.empty()) a.rollouts.resize(2 * cfg_.dedup_window);
+  return a;
+}
 
-  SeenRollout* slot = nullptr;
+RolloutAssembler::SeenRollout* RolloutAssembler::findSlot(ActorWindow& a, int64_t seq) {
   for (SeenRollout& r : a.rollouts)
-    if (r.seq == s) slot = &r;
+    if (r.seq == seq) return &r;
+  return nullptr;
+}
+
+namespace {
+void resetSlot(auto& slot, int64_t seq, int32_t num_chunks) {
+  slot.seq = seq;
+  slot.num_chunks = num_chunks;
+  slot.bits.assign((num_chunks + 63) / 64, 0);
+  slot.arrived.assign(slot.bits.size(), 0);
+}
+bool anyBit(const std::vector<uint64_t>& bits) {
+  for (uint64_t b : bits)
+    if (b != 0) return true;
+  return false;
+}
+}  // namespace
+
+RolloutAssembler::SeenRollout& RolloutAssembler::claimSlot(ActorWindow& a, int64_t seq, int32_t num_chunks) {
+  // The slots hold at most dedup_window rollouts behind the newest and dedup_window ahead of it, so
+  // the oldest slot is unused or outside the window (its losses already counted).
+  SeenRollout* oldest = &a.rollouts[0];
+  for (SeenRollout& r : a.rollouts)
+    if (r.seq < oldest->seq) oldest = &r;
+  resetSlot(*oldest, seq, num_chunks);
+  return *oldest;
+}
+
+DropReason RolloutAssembler::markAccepted(const masa::lcmt_rollout_chunk& m) {
+  ActorWindow& a = windowOf(m.actor_id);
+  const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
+  if (a.first < 0) startNumbering(a, m.actor_id, s);  // first sight
+
+  SeenRollout* slot = findSlot(a, s);
   if (slot == nullptr) {
-    if (a.first < 0 || s > a.newest + cfg_.max_rollout_gap || s + 2 * w < a.newest) {
-      // First sight, or a jump no live numbering makes: an actor restarted with the same id.
-      startNumbering(a, m.actor_id, s);
-    } else if (s <= a.newest - w) {
-      return DropReason::kDuplicate;  // behind the window: a replay or a straggler we can no longer check
-    } else if (s > a.newest) {
+    if (s > a.newest + w || s < a.newest - 2 * w) return acceptFarChunk(a, m);
+    if (s <= a.newest - w) return DropReason::kDuplicate;  // behind the window: a replay or a straggler we can no longer check
+    if (s > a.newest) {
+      a.candidate.seq = -1;  // the numbering moved on: a far rollout seen before it was not a restart
       closeRollouts(a, m.actor_id, s - cfg_.loss_horizon);
       a.newest = s;
     }
-    // At most w - 1 other slots hold rollouts within w of the newest, so the oldest slot is
-    // outside the window (its losses already counted) or unused.
-    SeenRollout* oldest = &a.rollouts[0];
-    for (SeenRollout& r : a.rollouts)
-      if (r.seq < oldest->seq) oldest = &r;
-    slot = oldest;
-    slot->seq = s;
-    slot->num_chunks = m.num_chunks;
-    slot->bits.assign((m.num_chunks + 63) / 64, 0);
-    slot->arrived.assign(slot->bits.size(), 0);
+    slot = &claimSlot(a, s, m.num_chunks);
   } else if (slot->num_chunks != m.num_chunks) {
-    return DropReason::kOutOfRange;  // chunks of one rollout disagree on how many there are
+    // Chunks of one rollout disagree on how many there are. Only arrivals of out-of-date chunks
+    // (perhaps hostile) made the slot so far: the first accepted chunk decides.
+    if (anyBit(slot->bits)) return DropReason::kOutOfRange;
+    resetSlot(*slot, s, m.num_chunks);
   }
   const std::size_t w64 = m.chunk_index / 64;
   const uint64_t bit = uint64_t{1} << (m.chunk_index % 64);
   if (slot->bits[w64] & bit) return DropReason::kDuplicate;
   const bool first_arrival = !(slot->arrived[w64] & bit);
-  (accepted ? slot->bits : slot->arrived)[w64] |= bit;
+  slot->bits[w64] |= bit;
   a.num_chunks = m.num_chunks;
-  if (accepted) ++a.tally.accepted;
+  ++a.tally.accepted;
   if (first_arrival && s <= a.closed && a.tally.lost > 0) {
     // Arrived after its rollout's losses were counted: it was not lost after all.
     --a.tally.lost;
     --stats_.count[static_cast<int>(DropReason::kLost)];
   }
   return DropReason::kAccepted;
+}
+
+DropReason RolloutAssembler::acceptFarChunk(ActorWindow& a, const masa::lcmt_rollout_chunk& m) {
+  SeenRollout& c = a.candidate;
+  const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
+  if (c.seq >= 0 && s > c.seq && s <= c.seq + w) {
+    // The far rollout's successor, with no progress of the current numbering in between: an
+    // outage that lost the rollouts in the gap, or a restarted actor.
+    SeenRollout far = std::move(c);
+    c.seq = -1;
+    if (far.seq > a.newest + cfg_.max_rollout_gap || far.seq < a.newest - 2 * w) {
+      startNumbering(a, m.actor_id, far.seq);
+    } else {
+      closeRollouts(a, m.actor_id, far.seq - cfg_.loss_horizon);
+      a.newest = far.seq;
+    }
+    a.num_chunks = far.num_chunks;
+    claimSlot(a, far.seq, far.num_chunks) = std::move(far);
+    return markAccepted(m);  // within the window now
+  }
+  if (c.seq != s || c.num_chunks != m.num_chunks) resetSlot(c, s, m.num_chunks);  // replaces an unconfirmed one
+  const std::size_t w64 = m.chunk_index / 64;
+  const uint64_t bit = uint64_t{1} << (m.chunk_index % 64);
+  if (c.bits[w64] & bit) return DropReason::kDuplicate;
+  c.bits[w64] |= bit;
+  ++a.tally.accepted;
+  return DropReason::kAccepted;
+}
+
+void RolloutAssembler::markArrived(const masa::lcmt_rollout_chunk& m) {
+  if (m.actor_id >= static_cast<int>(actors_.size())) return;  // an actor never accepted: nothing to follow
+  ActorWindow& a = actors_[m.actor_id];
+  const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
+  if (a.first < 0 || s <= a.newest - w || s > a.newest + w) return;
+  SeenRollout* slot = findSlot(a, s);
+  if (slot == nullptr) {
+    slot = &claimSlot(a, s, m.num_chunks);
+  } else if (slot->num_chunks != m.num_chunks) {
+    return;
+  }
+  const std::size_t w64 = m.chunk_index / 64;
+  const uint64_t bit = uint64_t{1} << (m.chunk_index % 64);
+  if ((slot->bits[w64] | slot->arrived[w64]) & bit) return;
+  slot->arrived[w64] |= bit;
+  if (s <= a.closed && a.tally.lost > 0) {
+    --a.tally.lost;
+    --stats_.count[static_cast<int>(DropReason::kLost)];
+  }
 }
 
 bool RolloutAssembler::warnDue(DropReason reason) {
@@ -268,25 +343,22 @@ Verdict RolloutAssembler::finish(DropReason reason, const masa::lcmt_rollout_chu
 Verdict RolloutAssembler::accept(const masa::lcmt_rollout_chunk& msg) {
   DropReason reason = validate(msg);
   if (reason == DropReason::kAccepted) {
-    reason = markSeen(msg, /*accepted=*/true);
+    reason = markAccepted(msg);
   } else if (reason == DropReason::kTooOld || reason == DropReason::kFutureVersion) {
     // Well-formed (the version is checked after the sizes and ranges) and merely out of date: it
     // arrived, so it must not be counted lost. Hostile chunks never mark anything as seen.
-    markSeen(msg, /*accepted=*/false);
+    markArrived(msg);
   }
   return finish(reason, &msg);
 }
 
 Verdict RolloutAssembler::acceptEncoded(const void* data, int size) {
-  if (!chunkWireLengthsFit(data, size)) return finish(DropReason::kMalformed, nullptr);
   clearArrays(decoded_);
-  int used = -1;
-  try {
-    used = decoded_.decode(data, 0, size);
-  } catch (const std::exception&) {  // bad_alloc / length_error: cannot happen after the guard
-    used = -1;
+  const WireVerdict wire = decodeChecked(data, size, decoded_);
+  if (wire != WireVerdict::kOk) {
+    ++wire_rejects_[static_cast<int>(wire)];
+    return finish(DropReason::kMalformed, nullptr);
   }
-  if (used != size) return finish(DropReason::kMalformed, nullptr);
   return accept(decoded_);
 }
 

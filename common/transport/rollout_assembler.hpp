@@ -10,10 +10,14 @@
 // Per actor it follows the rollout numbering (rollout_seq): duplicates are detected within the last
 // dedup_window rollouts, and chunks that never arrived are counted as kLost once the actor is
 // loss_horizon rollouts past their rollout (a wholly lost rollout counts as many chunks as the
-// actor's last rollout had). A jump ahead of more than max_rollout_gap rollouts, or back by more than
-// 2 * dedup_window, starts a new numbering: an actor restarted with the same id (masa_actor numbers
-// from its start time in microseconds, so a restart jumps millions ahead) is accepted at once, not
-// taken for a replay.
+// actor's last rollout had). Only an accepted chunk moves this bookkeeping; a chunk dropped as out
+// of date only marks its rollout's chunk as arrived (so that it is not also counted lost), and only
+// within the window. An accepted chunk far from the numbering (more than dedup_window ahead, or
+// more than 2 * dedup_window behind) is used, but believed only when its actor's next rollout
+// follows it before the current numbering moves on: then it is an outage (the gap is lost) or, past
+// max_rollout_gap ahead or behind the window, a restarted actor (masa_actor numbers from its start
+// time in microseconds, so a restart jumps millions ahead). A replayed chunk, or a copy of a live
+// one with a wild number, therefore neither counts chunks lost nor reports a restart.
 #pragma once
 
 #include <chrono>
@@ -22,6 +26,7 @@
 #include <vector>
 
 #include "common/transport/drop_reason.hpp"
+#include "common/transport/wire_guard.hpp"
 #include "masa/lcmt_rollout_chunk.hpp"
 
 namespace masa::transport {
@@ -84,6 +89,8 @@ class RolloutAssembler {
   Verdict acceptEncoded(const void* data, int size);
 
   const DropStats& stats() const { return stats_; }
+  // Why the wire guard rejected the bytes acceptEncoded counted as kMalformed.
+  const WireRejects& wireRejects() const { return wire_rejects_; }
   const AssemblerConfig& config() const { return cfg_; }
   // All zero for an actor id never seen.
   const ActorTally& actorTally(int actor_id) const;
@@ -96,20 +103,27 @@ class RolloutAssembler {
     std::vector<uint64_t> arrived;  // chunks that came but were out of date: not lost, not accepted
   };
   struct ActorWindow {
-    std::vector<SeenRollout> rollouts;  // dedup_window slots, replaced oldest first
+    std::vector<SeenRollout> rollouts;  // 2 * dedup_window slots, replaced oldest first
     int64_t first = -1;                 // first rollout seen in the current numbering (-1: none yet)
     int64_t newest = -1;                // newest rollout seen in it
     int64_t closed = -1;                // rollouts up to this one have had their losses counted
     int32_t num_chunks = 0;             // chunks per rollout, as last seen
+    SeenRollout candidate;              // an accepted rollout far from the numbering, not yet believed
     ActorTally tally;
   };
 
   DropReason validate(const masa::lcmt_rollout_chunk& m) const;
-  // Records the chunk's arrival for duplicate detection and loss counting. `accepted`: it passed
-  // validation, is checked for duplicates and counted in the actor's tally; otherwise it is only
-  // noted as arrived (so that no hostile copy can make the genuine chunk look like a duplicate).
-  // Returns kAccepted, kDuplicate or kOutOfRange.
-  DropReason markSeen(const masa::lcmt_rollout_chunk& m, bool accepted);
+  // Records a validated chunk for duplicate detection and loss counting, and moves the actor's
+  // numbering. Returns kAccepted, kDuplicate or kOutOfRange.
+  DropReason markAccepted(const masa::lcmt_rollout_chunk& m);
+  // Notes that a well-formed but out-of-date chunk arrived, so that it is not counted lost; moves
+  // nothing else, and nothing at all outside the actor's window.
+  void markArrived(const masa::lcmt_rollout_chunk& m);
+  // An accepted chunk far from the numbering: held as a candidate until its next rollout confirms it.
+  DropReason acceptFarChunk(ActorWindow& a, const masa::lcmt_rollout_chunk& m);
+  ActorWindow& windowOf(int actor_id);
+  SeenRollout* findSlot(ActorWindow& a, int64_t seq);
+  SeenRollout& claimSlot(ActorWindow& a, int64_t seq, int32_t num_chunks);  // replaces the oldest
   // Counts the missing chunks of rollouts (closed, upto] of the current numbering.
   void closeRollouts(ActorWindow& a, int actor_id, int64_t upto);
   void startNumbering(ActorWindow& a, int actor_id, int64_t seq);
@@ -119,6 +133,7 @@ class RolloutAssembler {
   AssemblerConfig cfg_;
   int64_t version_ = 0;
   DropStats stats_;
+  WireRejects wire_rejects_{};
   std::vector<ActorWindow> actors_;  // indexed by actor_id, grown on first sight
   masa::lcmt_rollout_chunk decoded_;  // reused by acceptEncoded
 

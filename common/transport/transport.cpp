@@ -64,6 +64,29 @@ void Transport::unsubscribe(SubscriptionId id) {
   }
 }
 
+WireRejects Transport::rejected(const std::string& channel) const {
+  const auto it = rejects_.find(channel);
+  return it == rejects_.end() ? WireRejects{} : it->second.count;
+}
+
+void Transport::countRejected(const std::string& channel, WireVerdict why) {
+  ++decode_errors_;
+  ChannelRejects& r = rejects_[channel];
+  ++r.count[static_cast<int>(why)];
+  ++r.unwarned;
+  // At most one line per channel every few seconds: a fuzzer must not fill the log.
+  constexpr auto kWarnInterval = std::chrono::seconds(5);
+  const auto now = std::chrono::steady_clock::now();
+  if (r.warned && now - r.last_warning < kWarnInterval) return;
+  int64_t total = 0;
+  for (int64_t n : r.count) total += n;
+  std::cerr << "masa transport: rejected " << r.unwarned << " message(s) on " << channel << " (latest: "
+            << wireVerdictName(why) << "); " << total << " rejected on this channel so far\n";
+  r.warned = true;
+  r.last_warning = now;
+  r.unwarned = 0;
+}
+
 int Transport::handleTimeout(int timeout_ms) { return lcm_->handleTimeout(timeout_ms); }
 
 int Transport::drain() {

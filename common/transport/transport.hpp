@@ -7,15 +7,19 @@
 // thread (handlers run on the thread that calls handle*()).
 #pragma once
 
+#include <array>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <list>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "common/transport/lcm_url.hpp"
+#include "common/transport/wire_guard.hpp"
 
 namespace lcm {
 class LCM;
@@ -53,12 +57,14 @@ class Transport {
   bool publish(const std::string& channel, const Msg& msg);
   bool publishRaw(const std::string& channel, const void* data, int size);
 
-  // Raw bytes, for input that must be bounds-checked before decoding (rollout chunks: see
-  // RolloutAssembler::acceptEncoded). Throws std::runtime_error when LCM cannot subscribe (udpm:
-  // its self test failed, e.g. a firewall drops the process's own multicast), rather than
-  // leaving a subscription that never receives anything.
+  // Raw bytes, for handlers that decode into a reused message (rollout chunks: see
+  // RolloutAssembler::acceptEncoded) or only measure them; a handler that decodes must do so with
+  // decodeChecked(). Throws std::runtime_error when LCM cannot subscribe (udpm: its self test
+  // failed, e.g. a firewall drops the process's own multicast), rather than leaving a
+  // subscription that never receives anything.
   SubscriptionId subscribeRaw(const std::string& channel, RawHandler handler);
-  // Decoded messages. A message that fails to decode is counted (decodeErrors()) and skipped.
+  // Decoded messages, each through the wire guard first (decodeChecked). A rejected message is
+  // counted under its channel and reason (rejected()), warned about at a rate limit, and skipped.
   template <class Msg>
   SubscriptionId subscribe(const std::string& channel, std::function<void(const Msg&)> handler);
   void unsubscribe(SubscriptionId id);
@@ -68,9 +74,13 @@ class Transport {
   // Dispatches every message already queued (without waiting); returns how many.
   int drain();
 
+  // Messages rejected by subscribe()'s guard: on all channels, and on one per reason.
   int64_t decodeErrors() const { return decode_errors_; }
+  WireRejects rejected(const std::string& channel) const;
 
  private:
+  void countRejected(const std::string& channel, WireVerdict why);
+
   struct Sub {
     SubscriptionId id;
     RawHandler handler;
@@ -83,6 +93,13 @@ class Transport {
   std::list<Sub> subs_;  // stable addresses: LCM keeps a pointer to each
   SubscriptionId next_id_ = 0;
   int64_t decode_errors_ = 0;
+  struct ChannelRejects {
+    WireRejects count{};
+    bool warned = false;
+    std::chrono::steady_clock::time_point last_warning{};
+    int64_t unwarned = 0;  // rejected since the last warning
+  };
+  std::map<std::string, ChannelRejects> rejects_;
   std::mutex publish_mutex_;
   std::vector<uint8_t> publish_buf_;
 };
@@ -98,21 +115,13 @@ bool Transport::publish(const std::string& channel, const Msg& msg) {
 
 template <class Msg>
 Transport::SubscriptionId Transport::subscribe(const std::string& channel, std::function<void(const Msg&)> handler) {
-  return subscribeRaw(channel, [this, handler = std::move(handler)](const void* data, int size) {
+  return subscribeRaw(channel, [this, channel, handler = std::move(handler)](const void* data, int size) {
     // A fresh message each time: the generated decoder leaves zero-length arrays untouched, so a
     // reused one could keep stale contents. Only rollout chunks are frequent enough to matter,
     // and they take the raw path.
     Msg msg;
-    int used = -1;
-    try {
-      used = msg.decode(data, 0, size);
-    } catch (const std::exception&) {  // hostile lengths: bad_alloc / length_error
-      used = -1;
-    }
-    if (used != size) {
-      ++decode_errors_;
-      return;
-    }
+    const WireVerdict verdict = decodeChecked(data, size, msg);
+    if (verdict != WireVerdict::kOk) return countRejected(channel, verdict);
     handler(msg);
   });
 }

@@ -251,6 +251,57 @@ TEST(ActorRollouts, ParametersOfAnotherRunOrTaskAreIgnored) {
   EXPECT_EQ(actor.paramsRejected(), 1);
 }
 
+// One rejected message must not outlive itself: an actor that remembered the version of a message
+// it rejected (2^51, with an unknown task) ignored every real update after it, for good.
+TEST(ActorRollouts, ARejectedParameterMessageIsNotRememberedAndTheLearnersNextParametersAreTaken) {
+  const auto rc = smallConfig(4);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  actor::Actor actor(rc, options(1, -1), &bus);
+  auto hostile = learner.message(int64_t{1} << 51);
+  hostile.task = "no_such_task";
+  bus.publish(transport::kPolicyChannel, hostile);
+  EXPECT_FALSE(actor.pollParams(10));
+  EXPECT_EQ(actor.paramsRejected(), 1);
+  bus.publish(transport::kPolicyChannel, learner.message(1));
+  ASSERT_TRUE(actor.pollParams(10)) << "the learner's first parameters after a rejected message";
+  EXPECT_EQ(actor.policyVersion(), 1);
+  // Again while acting: the next real version is swapped in at the next rollout.
+  bus.publish(transport::kPolicyChannel, hostile);
+  bus.publish(transport::kPolicyChannel, learner.message(2));
+  actor.pollParams(10);
+  ASSERT_TRUE(actor.collectAndPublish());
+  EXPECT_EQ(actor.policyVersion(), 2);
+  EXPECT_EQ(actor.paramsRejected(), 2);
+}
+
+// Versions are only believed as plausible steps: a message a million versions ahead of the actor
+// is rejected (and not remembered), so the learner's real next version is still taken.
+TEST(ActorRollouts, AVersionFarAheadOfTheActorsIsRejectedAndTheRealNextVersionIsTaken) {
+  const auto rc = smallConfig(4);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  actor::Actor actor(rc, options(1, -1), &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(1));
+  ASSERT_TRUE(actor.pollParams(10));
+  bus.publish(transport::kPolicyChannel, learner.message(1 + 2'000'000, 0.5f));
+  actor.pollParams(10);
+  ASSERT_TRUE(actor.collectAndPublish());
+  EXPECT_EQ(actor.policyVersion(), 1) << "a version 2e6 ahead must not be taken";
+  EXPECT_EQ(actor.paramsRejected(), 1);
+  bus.publish(transport::kPolicyChannel, learner.message(2));
+  actor.pollParams(10);
+  ASSERT_TRUE(actor.collectAndPublish());
+  EXPECT_EQ(actor.policyVersion(), 2);
+  // A fresh actor (no parameters yet) measures from version 0.
+  actor::Actor fresh(rc, options(1, -1), &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(int64_t{1} << 49));
+  EXPECT_FALSE(fresh.pollParams(10));
+  bus.publish(transport::kPolicyChannel, learner.message(3));
+  EXPECT_TRUE(fresh.pollParams(10));
+  EXPECT_EQ(fresh.policyVersion(), 3);
+}
+
 TEST(ActorRollouts, WholeModelParametersAreAcceptedAsWellAsThePolicyPrefix) {
   const auto rc = smallConfig(4);
   transport::Transport bus("memq://");

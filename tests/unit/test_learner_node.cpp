@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -191,7 +192,24 @@ TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTri
   EXPECT_EQ(countOf("wrong_run"), foreign);
   EXPECT_EQ(countOf("malformed"), 1);
   EXPECT_EQ(countOf("non_finite"), nan_chunks);
-  EXPECT_EQ(learner.droppedTotal(), foreign + 1 + nan_chunks);
+  EXPECT_EQ(learner.droppedChunks(), foreign + 1 + nan_chunks);
+  EXPECT_EQ(learner.droppedEnvs(), 0);
+  // metrics.csv: chunks and environments in columns of their own, never added together.
+  const auto lines = readLines(dir / "metrics.csv");
+  ASSERT_EQ(lines.size(), 2u);
+  auto cell = [&](const std::string& column) {
+    std::vector<std::string> head, row;
+    for (auto [line, out] : {std::pair{&lines[0], &head}, std::pair{&lines[1], &row}}) {
+      std::stringstream ss(*line);
+      for (std::string f; std::getline(ss, f, ',');) out->push_back(f);
+    }
+    for (std::size_t i = 0; i < head.size() && i < row.size(); ++i)
+      if (head[i] == column) return row[i];
+    return std::string("(no column ") + column + ")";
+  };
+  EXPECT_EQ(cell("dropped_chunks"), std::to_string(foreign + 1 + nan_chunks));
+  EXPECT_EQ(cell("dropped_envs"), "0");
+  EXPECT_EQ(cell("dropped"), "(no column dropped)");
   fs::remove_all(dir);
 }
 
@@ -232,6 +250,40 @@ TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv)
   EXPECT_EQ(lines[2].rfind("1,2,64,", 0), 0u);
   fs::remove_all(dir_a);
   fs::remove_all(dir_b);
+}
+
+// kill -9 of the learner between two checkpoints: metrics.csv has rows for updates the checkpoint
+// does not have. A resume cuts them off first, so every update has one row, in order.
+TEST(LearnerNode, ResumeCutsMetricsCsvBackToTheCheckpointsUpdate) {
+  auto rc = smallConfig();
+  rc.runner.checkpoint_every = 1;
+  const fs::path dir = freshDir("csv_cut"), saved = freshDir("csv_cut_ckpt");
+  FakeActor actor(rc, 10);
+  {
+    Learner a(rc, options(dir, 9));
+    for (int k = 0; k < 10; ++k) {
+      actor.send(a.transport(), 9, k, k);
+      ASSERT_TRUE(stepUntilUpdate(a)) << "update " << k;
+      if (k == 5) fs::copy(dir, saved, fs::copy_options::recursive);  // the checkpoint at update 6
+    }
+  }
+  ASSERT_EQ(readLines(dir / "metrics.csv").size(), 11u);  // header, rows 0..9
+  // The learner died after update 10's row but its newest checkpoint is update 6's.
+  fs::copy_file(saved / "checkpoint.bin", dir / "checkpoint.bin", fs::copy_options::overwrite_existing);
+  LearnerOptions o = options(dir, 0);
+  o.resume = true;
+  Learner b(rc, o);
+  ASSERT_EQ(b.version(), 6);
+  auto lines = readLines(dir / "metrics.csv");
+  ASSERT_EQ(lines.size(), 7u) << "header and rows 0..5";
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(lines[k + 1].rfind(std::to_string(k) + ",", 0), 0u) << lines[k + 1];
+  actor.send(b.transport(), 9, 6, 6);
+  ASSERT_TRUE(stepUntilUpdate(b));
+  lines = readLines(dir / "metrics.csv");
+  ASSERT_EQ(lines.size(), 8u);
+  EXPECT_EQ(lines[7].rfind("6,7,", 0), 0u) << lines[7];
+  fs::remove_all(dir);
+  fs::remove_all(saved);
 }
 
 }  // namespace

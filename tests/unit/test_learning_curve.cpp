@@ -27,8 +27,8 @@ fs::path freshDir(const std::string& name) {
 void writeMetrics(const fs::path& dir, int rows) {
   std::ofstream f(dir / "metrics.csv");
   f << "epoch,version,env_steps,wall_time_s,fps,return,length,success,term_alive,term_velocity,actor_loss,"
-       "critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped,"
-       "eval_return,eval_length,eval_success,eval_distance_m\n";
+       "critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped_chunks,"
+       "dropped_envs,eval_return,eval_length,eval_success,eval_distance_m\n";
   for (int i = 0; i < rows; ++i) {
     const bool ended = i != 1;
     f << i << ',' << i + 1 << ',' << (i + 1) * 2048 << ',' << i * 0.5 << ",4000,";
@@ -36,7 +36,7 @@ void writeMetrics(const fs::path& dir, int rows) {
       f << 10.0 + i << ',' << 20 + i << ",-1," << 0.5 * i << ',' << 1.0 + i;
     else
       f << "nan,nan,-1,nan,nan";
-    f << ",-0.01,0.5,1.2,0,0,0,0.002,0.0005,0.8,0.3,0";
+    f << ",-0.01,0.5,1.2,0,0,0,0.002,0.0005,0.8,0.3,0,0";
     if (i % 2 == 0)
       f << ',' << 12.0 + i << ',' << 25 + i << ",nan," << 0.1 * i << '\n';
     else

@@ -237,9 +237,60 @@ TEST(RolloutAssembler, RestartedActorIsAcceptedAtOnceAndItsJumpCountsAsANewNumbe
   EXPECT_EQ(assembler.actorTally(0).accepted, sent);
   // Duplicates are still caught within the new numbering.
   EXPECT_EQ(assembler.accept(makeChunks(0, second_start + 4)[0]).reason, DropReason::kDuplicate);
-  // A clock stepped back by more than the window is a new numbering as well, not a replay.
+  // A clock stepped back by more than the window is a new numbering as well, not a replay: its
+  // chunks are used at once, and it counts as a numbering once its second rollout follows.
   for (const auto& c : makeChunks(0, first_start - 1'000'000)) EXPECT_TRUE(assembler.accept(c));
+  EXPECT_EQ(assembler.actorTally(0).numberings, 2) << "one far rollout alone may be a replay or a forgery";
+  for (const auto& c : makeChunks(0, first_start - 1'000'000 + 1)) EXPECT_TRUE(assembler.accept(c));
   EXPECT_EQ(assembler.actorTally(0).numberings, 3);
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], 0);
+}
+
+// A replaying or fuzzing host on the LAN: old chunks sent again, and copies of live chunks with
+// wild rollout numbers (accepted as data or dropped for their version). None of them may move the
+// actor's numbering: no chunk counted lost, no restart reported.
+TEST(RolloutAssembler, ReplayedChunksAndWildRolloutNumbersChangeNeitherLostNorRestarts) {
+  RolloutAssembler assembler(assemblerConfig(/*lag=*/1));
+  const int64_t start = 1'700'000'000'000'000;
+  const int kRollouts = 40;  // well past twice the dedup window
+  std::vector<std::vector<masa::lcmt_rollout_chunk>> sent;
+  for (int k = 0; k < kRollouts; ++k) {
+    assembler.setLearnerVersion(k);
+    sent.push_back(makeChunks(k, start + k));
+    for (const auto& c : sent.back()) ASSERT_TRUE(assembler.accept(c));
+  }
+  ASSERT_EQ(assembler.stats()[DropReason::kLost], 0);
+  ASSERT_EQ(assembler.actorTally(0).numberings, 1);
+
+  // Replays of every old chunk, oldest first (too old for the learner now, or duplicates).
+  for (const auto& rollout : sent)
+    for (const auto& c : rollout) EXPECT_FALSE(assembler.accept(c));
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], 0) << "replays";
+  EXPECT_EQ(assembler.actorTally(0).numberings, 1) << "replays";
+
+  // Copies of the newest rollout's chunks with wild numbers, at the current version (they pass
+  // every check) and at an old one (dropped as too old).
+  const int64_t newest = start + kRollouts - 1;
+  for (int64_t wild : {newest + 1000, newest + 100'000, newest - 1000, int64_t{0}, int64_t{1} << 50, newest + 40,
+                       newest - 40, newest + 5000}) {
+    for (int64_t version : {int64_t{kRollouts - 1}, int64_t{0}}) {
+      for (masa::lcmt_rollout_chunk c : sent.back()) {
+        c.rollout_seq = wild;
+        c.policy_version = version;
+        assembler.accept(c);
+      }
+    }
+  }
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], 0) << "wild rollout numbers";
+  EXPECT_EQ(assembler.actorTally(0).numberings, 1) << "wild rollout numbers";
+
+  // The real actor goes on: its next rollouts are accepted, nothing is lost.
+  for (int k = kRollouts; k < kRollouts + 3; ++k) {
+    assembler.setLearnerVersion(k);
+    for (const auto& c : makeChunks(k, start + k)) EXPECT_TRUE(assembler.accept(c)) << "rollout " << k;
+  }
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], 0);
+  EXPECT_EQ(assembler.actorTally(0).numberings, 1);
 }
 
 TEST(RolloutAssembler, ARestartThatReusedItsNumberingWouldBeTakenForReplays) {
@@ -318,6 +369,10 @@ TEST(RolloutAssembler, MalformedBytesAreDroppedWithoutDecodingHostileLengths) {
             DropReason::kMalformed);
   EXPECT_EQ(assembler.acceptEncoded(nullptr, 0).reason, DropReason::kMalformed);
   EXPECT_EQ(assembler.stats()[DropReason::kMalformed], 4);
+  // And why, by the wire guard's reasons.
+  EXPECT_EQ(assembler.wireRejects()[static_cast<int>(WireVerdict::kTruncated)], 2);  // the cut and nullptr
+  EXPECT_EQ(assembler.wireRejects()[static_cast<int>(WireVerdict::kOverLimit)], 1);
+  EXPECT_EQ(assembler.wireRejects()[static_cast<int>(WireVerdict::kNegativeLength)], 1);
   // The intact bytes decode and pass, even after a chunk with empty arrays was decoded into the
   // same reused message (the generated decoder leaves zero-length arrays untouched).
   EXPECT_TRUE(assembler.acceptEncoded(bytes.data(), static_cast<int>(bytes.size())));

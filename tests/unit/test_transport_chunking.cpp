@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "common/transport/batch_collector.hpp"
-#include "common/transport/chunk_wire_guard.hpp"
 #include "common/transport/rollout_assembler.hpp"
 #include "common/transport/rollout_chunker.hpp"
+#include "common/transport/wire_guard.hpp"
 #include "test_transport_support.hpp"
 
 namespace masa::transport {
@@ -165,6 +165,10 @@ TEST(RolloutChunker, EnvironmentLargerThanTheBudgetGoesAloneAndIsCounted) {
   const auto chunks = chunker.split(r, {});
   EXPECT_EQ(static_cast<int>(chunks.size()), kHumanoid.num_envs);
   EXPECT_EQ(chunker.oversizeChunks(), kHumanoid.num_envs);
+}
+
+bool chunkWireLengthsFit(const void* data, int size) {
+  return checkWire<masa::lcmt_rollout_chunk>(data, size) == WireVerdict::kOk;
 }
 
 TEST(ChunkWireGuard, AcceptsEncodedChunksAndRejectsEveryTruncationOrLengthPastTheEnd) {
