@@ -138,6 +138,12 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
     std::copy(m.obs_mean.begin(), m.obs_mean.end(), pending_mean_.begin());
     std::copy(m.obs_std.begin(), m.obs_std.end(), pending_std_.begin());
   }
+  if (rollout_end_s_ > 0 && m.version > version_) {
+    // How long the learner took to answer the last rollout: the wait after the next one adapts to it.
+    const double delay = nowSeconds() - rollout_end_s_;
+    learner_delay_s_ = learner_delay_s_ > 0 ? 0.7 * learner_delay_s_ + 0.3 * delay : delay;
+    rollout_end_s_ = 0;
+  }
   pending_version_ = m.version;
   pending_has_norm_ = m.obs_dim > 0;
 }
@@ -192,8 +198,15 @@ void Actor::maybeHeartbeat() {
   if (nowSeconds() - last_heartbeat_s_ >= options_.heartbeat_interval_s) publishHeartbeat();
 }
 
+double Actor::awaitLimitSeconds() const {
+  if (options_.await_params_s <= 0) return 0.0;
+  // A learner whose updates take longer than the configured wait (a big batch, a loaded machine)
+  // would otherwise get stale rollouts it must drop: wait 1.5x its recent answer time, bounded.
+  return std::max(options_.await_params_s, std::min(options_.await_params_max_s, 1.5 * learner_delay_s_));
+}
+
 void Actor::awaitNewerParams() {
-  const double deadline = nowSeconds() + options_.await_params_s;
+  const double deadline = nowSeconds() + awaitLimitSeconds();
   for (double now = nowSeconds(); pending_version_ <= version_ && now < deadline && !stopRequested(); now = nowSeconds()) {
     // Short slices: the stop flag and heartbeats are served while waiting.
     transport_->handleTimeout(static_cast<int>(std::min(100.0, std::ceil((deadline - now) * 1000.0))));
@@ -280,6 +293,7 @@ bool Actor::collectAndPublish() {
     ++chunks_published_;
   }
   ++rollouts_sent_;
+  rollout_end_s_ = nowSeconds();
   return true;
 }
 

@@ -54,6 +54,9 @@ struct ActorOptions {
   // max_policy_lag 0, a third of the data in a 2-actor run). Bounded, so that a batch still fills
   // when another actor is dead (at the cost of this wait per update). 0: never wait.
   double await_params_s = 1.0;
+  // The wait grows to 1.5x the learner's recent answer time (from the end of a rollout to the
+  // next parameters), up to this bound: a big batch's update outlasts await_params_s.
+  double await_params_max_s = 10.0;
   // Parameters are believed only as plausible steps: a version more than this far ahead of the
   // actor's (of 0 before the first) is rejected. No run makes a million updates; a forged or fuzzed
   // version (2^51) would otherwise make the actor ignore every real update after it.
@@ -106,6 +109,7 @@ class Actor {
   bool stopRequested() const { return options_.stop && options_.stop->load(std::memory_order_relaxed); }
   void maybeHeartbeat();
   void awaitNewerParams();  // see ActorOptions::await_params_s
+  double awaitLimitSeconds() const;
 
   config::RunConfig config_;
   ActorOptions options_;
@@ -137,6 +141,8 @@ class Actor {
   std::vector<float> pending_params_, pending_mean_, pending_std_;
   int pending_count_ = 0;
   bool pending_has_norm_ = false;
+  double rollout_end_s_ = 0;    // when the last rollout was published (0: answered already)
+  double learner_delay_s_ = 0;  // moving average of the learner's answer time to a rollout
   // Nothing of a rejected message is kept but these counts: it cannot change what comes after it.
   int64_t params_rejected_ = 0;
   int64_t rejects_since_warning_ = 0;

@@ -41,6 +41,9 @@ int main(int argc, char** argv) {
   app.add_option("--await-params-s", opt.await_params_s,
                  "after each rollout, wait up to this long for newer parameters (0: never; keeps data on-policy)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--await-params-max-s", opt.await_params_max_s,
+                 "the wait adapts to the learner's answer time (1.5x), up to this long")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_flag("--start-without-learner", opt.start_without_learner,
                "act with own initial parameters (version 0) instead of waiting for the learner");
   app.add_option("--first-rollout-seq", opt.first_rollout_seq,

@@ -83,8 +83,20 @@ double robotViewDistance(const mjModel* model, const mjData* data) {
 }
 
 int rootBody(const mjModel* model) {
-  for (int j = 0; j < model->njnt; ++j)
-    if (model->jnt_type[j] == mjJNT_FREE) return model->jnt_bodyid[j];
+  // The robot, not a ball or a pole: of the bodies with a free joint, the one with most descendants.
+  int best = -1, best_size = -1;
+  for (int j = 0; j < model->njnt; ++j) {
+    if (model->jnt_type[j] != mjJNT_FREE) continue;
+    const int b = model->jnt_bodyid[j];
+    int size = 0;
+    for (int c = b + 1; c < model->nbody; ++c) {
+      int up = c;
+      while (up > b) up = model->body_parentid[up];
+      size += up == b;
+    }
+    if (size > best_size) best = b, best_size = size;
+  }
+  if (best >= 0) return best;
   return model->nbody > 1 ? 1 : 0;
 }
 

@@ -39,8 +39,8 @@ class OffscreenRenderer {
   std::vector<unsigned char> rgb_, flipped_;
 };
 
-// The body a camera should follow: the one that carries the model's first free joint (a floating
-// robot's trunk), else body 1.
+// The body a camera should follow: of the bodies with a free joint, the one with the most
+// descendants (a floating robot's trunk, not a ball or a pole it plays with), else body 1.
 int rootBody(const mjModel* model);
 // A camera distance that frames the robot (its root body's subtree, as posed in `data`), not the
 // whole scene (a 50 m beam).
