@@ -109,6 +109,7 @@ Actor::~Actor() = default;
 void Actor::onParams(const masa::lcmt_policy_params& m) {
   if (m.run_id != options_.run_id) return;  // another run on the same network
   const int64_t newest = std::max(version_, pending_version_);
+  if (m.version == newest) last_learner_s_ = nowSeconds();  // the learner's periodic repeat: it is alive
   if (m.version <= newest) return;  // the learner repeats its latest parameters periodically
   auto reject = [&](const std::string& why) { rejectParams(m.version, why); };
   if (m.version - std::max<int64_t>(newest, 0) > options_.max_version_step)
@@ -146,6 +147,7 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
   }
   pending_version_ = m.version;
   pending_has_norm_ = m.obs_dim > 0;
+  last_learner_s_ = nowSeconds();
 }
 
 void Actor::rejectParams(int64_t version, const std::string& why) {
@@ -297,11 +299,33 @@ bool Actor::collectAndPublish() {
   return true;
 }
 
+bool Actor::awaitLearnerIfSilent() {
+  const double pause = options_.learner_silence_pause_s, exit_after = options_.learner_silence_exit_s;
+  if (pause <= 0 || nowSeconds() - last_learner_s_ < pause) return true;
+  std::fprintf(stderr, "masa_actor %d: nothing from the learner for %.0f s; not publishing until it is back%s\n",
+               options_.actor_id, nowSeconds() - last_learner_s_,
+               exit_after > 0 ? (", exiting after " + std::to_string(static_cast<int>(exit_after)) + " s").c_str() : "");
+  while (!stopRequested() && nowSeconds() - last_learner_s_ >= pause) {
+    if (exit_after > 0 && nowSeconds() - last_learner_s_ >= exit_after) {
+      std::fprintf(stderr, "masa_actor %d: nothing from the learner for %.0f s; exiting\n", options_.actor_id,
+                   nowSeconds() - last_learner_s_);
+      return false;
+    }
+    transport_->handleTimeout(100);
+    transport_->drain();
+    maybeHeartbeat();
+  }
+  if (!stopRequested()) std::fprintf(stderr, "masa_actor %d: the learner is back\n", options_.actor_id);
+  return !stopRequested();
+}
+
 int64_t Actor::run() {
   publishHeartbeat();  // announce at start, before any parameters
   while (!stopRequested() && !pollParams(100)) {
   }
+  last_learner_s_ = std::max(last_learner_s_, nowSeconds());
   while (!stopRequested() && (options_.max_rollouts < 0 || rollouts_sent_ < options_.max_rollouts)) {
+    if (!awaitLearnerIfSilent()) break;
     if (!collectAndPublish()) break;
     if (options_.max_rollouts < 0 || rollouts_sent_ < options_.max_rollouts) awaitNewerParams();
   }

@@ -57,6 +57,10 @@ struct ActorOptions {
   // The wait grows to 1.5x the learner's recent answer time (from the end of a rollout to the
   // next parameters), up to this bound: a big batch's update outlasts await_params_s.
   double await_params_max_s = 10.0;
+  // An actor whose learner is gone (no parameters, not even the learner's periodic repeat) stops
+  // publishing after this long, says so, and exits after learner_silence_exit_s. 0: never.
+  double learner_silence_pause_s = 30.0;
+  double learner_silence_exit_s = 300.0;
   // Parameters are believed only as plausible steps: a version more than this far ahead of the
   // actor's (of 0 before the first) is rejected. No run makes a million updates; a forged or fuzzed
   // version (2^51) would otherwise make the actor ignore every real update after it.
@@ -110,6 +114,8 @@ class Actor {
   void maybeHeartbeat();
   void awaitNewerParams();  // see ActorOptions::await_params_s
   double awaitLimitSeconds() const;
+  // Before a rollout: true to go on; waits while the learner is silent, false when it is gone.
+  bool awaitLearnerIfSilent();
 
   config::RunConfig config_;
   ActorOptions options_;
@@ -142,6 +148,7 @@ class Actor {
   int pending_count_ = 0;
   bool pending_has_norm_ = false;
   double rollout_end_s_ = 0;    // when the last rollout was published (0: answered already)
+  double last_learner_s_ = 0;   // when the learner was last heard (new parameters or its repeat)
   double learner_delay_s_ = 0;  // moving average of the learner's answer time to a rollout
   // Nothing of a rejected message is kept but these counts: it cannot change what comes after it.
   int64_t params_rejected_ = 0;

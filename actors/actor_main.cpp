@@ -44,6 +44,12 @@ int main(int argc, char** argv) {
   app.add_option("--await-params-max-s", opt.await_params_max_s,
                  "the wait adapts to the learner's answer time (1.5x), up to this long")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--learner-silence-pause-s", opt.learner_silence_pause_s,
+                 "stop publishing after hearing nothing from the learner this long (0: never)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--learner-silence-exit-s", opt.learner_silence_exit_s,
+                 "exit after hearing nothing from the learner this long (0: never)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_flag("--start-without-learner", opt.start_without_learner,
                "act with own initial parameters (version 0) instead of waiting for the learner");
   app.add_option("--first-rollout-seq", opt.first_rollout_seq,

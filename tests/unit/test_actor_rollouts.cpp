@@ -2,6 +2,8 @@
 // chunks and heartbeats out.
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include <chrono>
 
 #include <cmath>
@@ -338,6 +340,9 @@ TEST(ActorRollouts, ARestartedActorNumbersItsRolloutsPastItsPreviousProcessAndIs
   opt.first_rollout_seq = actor::kRolloutSeqFromClock;  // what masa_actor does
   int64_t first_seq[2];
   for (int process = 0; process < 2; ++process) {  // the same actor id, twice: killed and restarted
+    // A restart takes longer than the assembler's max_rollout_gap (4096 rollouts, here microseconds
+    // of clock-based numbering); two processes a few microseconds apart would read as an outage.
+    if (process == 1) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     actor::Actor actor(rc, opt, &bus);
     first_seq[process] = actor.firstRolloutSeq();
     bus.publish(transport::kPolicyChannel, learner.message(1));
@@ -430,6 +435,46 @@ TEST(ActorRollouts, NewerParametersEndTheWaitAtOnce) {
   EXPECT_EQ(actor.run(), 2);
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 20.0);
   EXPECT_GE(actor.policyVersion(), 1);
+}
+
+// An actor whose learner is gone stops publishing and exits (issue #9: it used to simulate and
+// publish forever). Here the learner sends its parameters once and is never heard again.
+TEST(ActorRollouts, AnActorWhoseLearnerFallsSilentStopsPublishingAndExits) {
+  const auto rc = smallConfig(10);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  auto opt = options(2, 20);
+  opt.await_params_s = 0.05;
+  opt.learner_silence_pause_s = 0.3;
+  opt.learner_silence_exit_s = 0.8;
+  int chunks = 0;
+  bus.subscribeRaw(transport::kRolloutChannel, [&](const void*, int) { ++chunks; });
+  actor::Actor actor(rc, opt, &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(0));
+  const auto start = std::chrono::steady_clock::now();
+  const int64_t rollouts = actor.run();
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(rollouts, 20) << "the actor went on publishing without its learner";
+  EXPECT_GE(rollouts, 1);
+  EXPECT_GE(elapsed, 0.8);
+  EXPECT_LT(elapsed, 5.0);
+  EXPECT_GT(chunks, 0);
+}
+
+// The learner's periodic repeat of the parameters the actor already holds keeps it publishing.
+TEST(ActorRollouts, TheLearnersRepeatedParametersKeepTheActorGoing) {
+  const auto rc = smallConfig(11);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  auto opt = options(2, 6);
+  opt.await_params_s = 0.15;
+  opt.learner_silence_pause_s = 0.3;
+  opt.learner_silence_exit_s = 0.6;
+  // Every rollout is answered with a repeat of version 0, as a busy learner's republish would be.
+  bus.subscribeRaw(transport::kRolloutChannel, [&](const void*, int) { bus.publish(transport::kPolicyChannel, learner.message(0)); });
+  actor::Actor actor(rc, opt, &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(0));
+  EXPECT_EQ(actor.run(), 6);
 }
 
 }  // namespace
