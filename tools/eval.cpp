@@ -100,7 +100,7 @@ void film(const task::TaskFactory& factory, model::ActorCritic<float>& model, ta
   render::OffscreenRenderer renderer(env->model(), width, height);
   if (camera_distance <= 0) camera_distance = render::robotViewDistance(env->model(), env->data());
   renderer.trackBody(render::rootBody(env->model()), camera_distance, 135.0, -20.0);
-  const bool is_strip = video.size() > 4 && video.substr(video.size() - 4) == ".png";
+  const bool is_strip = render::isStripPath(video);
   const int every = std::max(1, static_cast<int>(std::lround(1.0 / (fps * env->controlTimestep()))));
   render::StripSampler sampler(strip);
   std::unique_ptr<render::FrameWriter> writer;
@@ -115,12 +115,7 @@ void film(const task::TaskFactory& factory, model::ActorCritic<float>& model, ta
       ++frames;
     }
   });
-  if (is_strip) {
-    const auto picked = sampler.pick();
-    render::FrameWriter strip_writer(video, renderer.width(), renderer.height(), fps, static_cast<int>(picked.size()));
-    for (const auto* image : picked) strip_writer.write(*image);
-    frames = static_cast<int>(picked.size());
-  }
+  if (is_strip) frames = sampler.writeStrip(video, renderer.width(), renderer.height());
   writer.reset();  // ffmpeg finishes the file
   std::printf("wrote %s (%d frames of episode seed %llu)\n", video.c_str(), frames, static_cast<unsigned long long>(seed));
 }

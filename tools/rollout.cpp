@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
       // Small scenes (TriFinger) from their extent; long ones (a 100 m rope) at a walking robot's scale.
       if (camera_distance <= 0) camera_distance = std::min(3.0, 1.5 * env->model()->stat.extent);
       renderer->trackBody(render::rootBody(env->model()), camera_distance, 135.0, -20.0);
-      is_strip = video.size() > 4 && video.substr(video.size() - 4) == ".png";
+      is_strip = render::isStripPath(video);
       if (!is_strip) writer = std::make_unique<render::FrameWriter>(video, renderer->width(), renderer->height(), fps);
       render_every = std::max(1, static_cast<int>(std::lround(1.0 / (fps * env->controlTimestep()))));
     }
@@ -126,12 +126,7 @@ int main(int argc, char** argv) {
     if (env->episode().has_success) std::printf(", success rate %.2f", double(successes) / episodes);
     std::printf("\nreward terms (mean sum per episode):\n");
     for (size_t k = 0; k < names.size(); ++k) std::printf("  %-14s %10.3f\n", names[k].c_str(), term_total[k] / episodes);
-    if (is_strip) {
-      const auto picked = sampler.pick();
-      render::FrameWriter strip_writer(video, renderer->width(), renderer->height(), fps, static_cast<int>(picked.size()));
-      for (const auto* image : picked) strip_writer.write(*image);
-      frames = static_cast<int>(picked.size());
-    }
+    if (is_strip) frames = sampler.writeStrip(video, renderer->width(), renderer->height());
     writer.reset();  // ffmpeg finishes the file
     if (!video.empty()) std::printf("wrote %s (%d frames)\n", video.c_str(), frames);
   } catch (const ConfigError& e) {

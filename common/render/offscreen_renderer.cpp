@@ -100,8 +100,10 @@ int rootBody(const mjModel* model) {
   return model->nbody > 1 ? 1 : 0;
 }
 
+bool isStripPath(const std::string& path) { return path.size() > 4 && path.substr(path.size() - 4) == ".png"; }
+
 FrameWriter::FrameWriter(const std::string& path, int width, int height, double fps, int strip_frames)
-    : path_(path), strip_(path.size() > 4 && path.substr(path.size() - 4) == ".png"), strip_frames_(strip_frames) {
+    : path_(path), strip_(isStripPath(path)), strip_frames_(strip_frames) {
   std::string filter = strip_ ? "-vf tile=" + std::to_string(strip_frames) + "x1 -frames:v 1 -update 1"
                               : (path.size() > 4 && path.substr(path.size() - 4) == ".gif" ? "" : "-pix_fmt yuv420p");
   const std::string cmd = "ffmpeg -y -loglevel error -f rawvideo -pixel_format rgb24 -video_size " +

@@ -46,6 +46,9 @@ int rootBody(const mjModel* model);
 // whole scene (a 50 m beam).
 double robotViewDistance(const mjModel* model, const mjData* data);
 
+// A .png output is an image strip (frames tiled side by side); anything else is a video.
+bool isStripPath(const std::string& path);
+
 // Pipes raw RGB frames into ffmpeg. The output kind follows the file extension.
 class FrameWriter {
  public:

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/render/offscreen_renderer.hpp"
+
 namespace masa::render {
 
 StripSampler::StripSampler(int frames) : frames_(frames) {
@@ -40,6 +42,13 @@ std::vector<const StripSampler::Image*> StripSampler::pick() const {
   std::vector<const Image*> out;
   for (size_t i : pickIndices()) out.push_back(&kept_[i].second);
   return out;
+}
+
+int StripSampler::writeStrip(const std::string& path, int width, int height) const {
+  const auto picked = pick();
+  FrameWriter writer(path, width, height, /*fps=*/1.0, static_cast<int>(picked.size()));
+  for (const Image* image : picked) writer.write(*image);
+  return static_cast<int>(picked.size());
 }
 
 std::vector<int> StripSampler::pickedSteps() const {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -24,6 +25,8 @@ class StripSampler {
   // min(frames, steps kept) images, evenly spread, in step order.
   std::vector<const Image*> pick() const;
   std::vector<int> pickedSteps() const;
+  // Writes the picked images as a .png strip of width x height frames; returns how many.
+  int writeStrip(const std::string& path, int width, int height) const;
 
  private:
   std::vector<std::size_t> pickIndices() const;
