@@ -8,7 +8,7 @@
 #   MASA_BENCH_NETS (default "Policy ActorCritic"), MASA_BENCH_MIN_TIME (seconds a run lasts, 1),
 #   MASA_BENCH_SETUPS (default: all four below), MASA_BENCH_KEEP (a folder to keep the JSON in).
 #
-# Set-ups (LibTorch is Debian's libtorch-dev, 1.13.1; deploy/install_bench_deps.sh installs it):
+# Set-ups (LibTorch is Debian's libtorch-dev, 1.13.1; scripts/install_bench_deps.sh installs it):
 #   ours            bench_learner_step, 1 and 2 OpenMP threads
 #   torch-refblas   LibTorch as libtorch-dev alone installs it: the reference BLAS (libblas3)
 #   torch-openblas  LibTorch on OpenBLAS (the libblas.so.3 alternative once libopenblas0 is
@@ -29,7 +29,7 @@ libdir=/usr/lib/x86_64-linux-gnu
 
 [ -x "$ours" ] || { echo "missing $ours: build the benchmarks first" >&2; exit 1; }
 [ -x "$torch" ] || {
-  echo "missing $torch: run deploy/install_bench_deps.sh, then reconfigure and build" >&2
+  echo "missing $torch: run scripts/install_bench_deps.sh, then reconfigure and build" >&2
   exit 1
 }
 read -r -a setups <<<"${MASA_BENCH_SETUPS:-ours torch-refblas torch-openblas torch-tuned}"

@@ -11,7 +11,7 @@ set -euo pipefail
 
 [ $# -ge 1 ] || { echo "tethered.sh: usage: tethered.sh PROGRAM [ARGS...]" >&2; exit 2; }
 if ! command -v "$1" >/dev/null; then
-  echo "tethered.sh: $1 is missing on $(hostname) (in $PWD): build there first (deploy/build.sh)" >&2
+  echo "tethered.sh: $1 is missing on $(hostname) (in $PWD): build there first (scripts/build.sh)" >&2
   exit 2
 fi
 

@@ -43,7 +43,7 @@ done
 
 build=${MASA_BUILD_DIR:-build}
 for bin in "$build/learner/masa_learner" "$build/actors/masa_actor" "$build/tools/masa_config"; do
-  [ -x "$bin" ] || { echo "train.sh: $bin is missing: run deploy/build.sh first" >&2; exit 2; }
+  [ -x "$bin" ] || { echo "train.sh: $bin is missing: run scripts/build.sh first" >&2; exit 2; }
 done
 
 # A recipe names the task, the method, the batch and the run's length; what the command line

@@ -126,7 +126,7 @@ bool LearningCurve::spawn() {
   if (err != 0) {
     gnuplot_missing_ = true;
     std::cerr << "masa_learner: cannot run gnuplot (" << std::strerror(err) << "): no learning_curve.png; install "
-              << "it with deploy/install_deps.sh (package gnuplot-nox)\n";
+              << "it with scripts/install_deps.sh (package gnuplot-nox)\n";
     return false;
   }
   child_ = pid;

@@ -54,7 +54,7 @@ bool isPng(const fs::path& p) {
 bool haveGnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
 TEST(LearningCurve, RendersAPngFromMetricsWithEveryRewardTerm) {
-  if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed (deploy/install_deps.sh installs gnuplot-nox)";
+  if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed (scripts/install_deps.sh installs gnuplot-nox)";
   const fs::path dir = freshDir("render");
   writeMetrics(dir, 6);
   LearningCurve curve(dir.string(), "a1_beam / masa", {"alive", "velocity"});

@@ -3,7 +3,7 @@
 # (masa_verify), train the task with its recipe (configs/recipes/<task>.yaml: one learner and
 # 2 actors over loopback LCM, sized for 2 cores), then evaluate the trained policy mean over 20
 # episodes and draw an image strip of one episode.
-#   deploy/run.sh [task] [method] [--actors K] [--updates N] [--set key=value ...]
+#   scripts/run.sh [task] [method] [--actors K] [--updates N] [--set key=value ...]
 # Ctrl-C stops training and leaves a resumable run (deploy/train.sh --resume DIR); the evaluation
 # and the strip then show the policy as far as it got.
 set -euo pipefail
@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 task=a1_beam method=""
 [ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; shift; }
 [ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; shift; }
-bash deploy/build.sh
+bash scripts/build.sh
 ./build/tools/masa_verify --task "$task" --top 3
 
 run_dir="${MASA_RUNS_DIR:-runs}/${task}_${method:-recipe}_$(date +%Y%m%d_%H%M%S)"

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Opens lcm-spy on masa's LCM traffic, with masa's message types decoded.
 #
-#   deploy/lcm_spy.sh [URL]     URL defaults to udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608
+#   scripts/lcm_spy.sh [URL]     URL defaults to udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608
 #
 # Debian's /usr/bin/lcm-spy does not start on Java 17 (it passes -Xincgc) and lacks jchart2d on
 # its class path, so this runs lcm.spy.Spy directly. It needs a JRE, liblcm-java, libjchart2d-java
-# (deploy/install_deps.sh) and build/lcmtypes/masa_lcmtypes.jar, which it builds when missing.
+# (scripts/install_deps.sh) and build/lcmtypes/masa_lcmtypes.jar, which it builds when missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,7 +17,7 @@ JCHART_JAR=/usr/share/java/jchart2d.jar
 
 die() { echo "lcm_spy.sh: $*" >&2; exit 1; }
 
-command -v java >/dev/null || die "java not found: install a JRE (sudo apt-get install default-jre-headless, or run deploy/install_deps.sh)"
+command -v java >/dev/null || die "java not found: install a JRE (sudo apt-get install default-jre-headless, or run scripts/install_deps.sh)"
 [[ -f "$LCM_JAR" ]] || die "$LCM_JAR missing: sudo apt-get install liblcm-java"
 [[ -f "$JCHART_JAR" ]] || die "$JCHART_JAR missing: sudo apt-get install libjchart2d-java"
 

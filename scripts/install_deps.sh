@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package masa needs to build, test, run and monitor.
 # Idempotent: packages already present are left alone; safe to run again.
-#   deploy/install_deps.sh [--bench]
+#   scripts/install_deps.sh [--bench]
 set -euo pipefail
 
 packages=(
