@@ -1,17 +1,27 @@
 #!/usr/bin/env bash
 # An experiment grid: every task x method x seed trained with masa_train (learner and one actor in
-# one process, deterministic per seed), as many runs at once as there are cores, then one
-# comparison plot per task (mean return over seeds against env steps, one line per method).
-#   experiments/grid.sh --tasks "a1_beam ant_acrobatic" --methods "masa sa sasa ma" --seeds "0 1 2" \
-#       --updates 300 [--jobs N] [--out DIR] [--set key=value ...]
-#   experiments/grid.sh --replot --out DIR --tasks ... --methods ... --seeds ...   (summary and plots only)
-# Results: DIR/<task>/<method>_s<seed>/ (the run directories: config.yaml, metrics.csv, ...),
-# DIR/<task>/summary.csv (final return per run: mean of the last 10 updates) and
-# DIR/<task>/compare.png. MASA_BUILD_DIR chooses the build (default build).
+# one process, deterministic per seed) from the task's recipe, as many runs at once as there are
+# slots, then the comparison: figures, statistics and verdict of masa_compare (tools/compare.cpp).
+#   experiments/grid.sh --tasks "a1_beam" --methods "masa sa sasa ma" --seeds "0 1 2 3 4" \
+#       [--updates N] [--no-recipe] [--jobs N] [--threads T] [--hosts FILE] [--out DIR] [--set key=value ...]
+#   experiments/grid.sh --replot --out DIR      (only the comparison of an existing grid)
+# Resumable: run the same command again (or with --out DIR) after a kill. A finished run (its
+# `done` file) is not redone, a run with a checkpoint goes on from it, the rest start afresh.
+# Runs are taken seed by seed, so a grid stopped early has whole seeds of every method.
+# Results: DIR/<task>/<method>_s<seed>/ (run directories: config.yaml, metrics.csv, policy.bin, ...,
+# and <method>_s<seed>.log), DIR/grid.txt (the grid), DIR/<task>/compare*.png and verdict.md.
+# --hosts FILE: one line per host, "name [slots]" ("localhost" runs here). Remote hosts need this
+# checkout, built, at the same path; the run directory is copied there before and back after each
+# run (MASA_SSH and MASA_RSYNC choose the commands, default ssh and rsync).
+# MASA_BUILD_DIR chooses the build (default build).
 set -euo pipefail
+caller=$(pwd)
 cd "$(dirname "$0")/.."
+repo=$(pwd)
+# --out and --hosts are the caller's paths; MASA_BUILD_DIR is relative to the checkout.
+abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
 
-tasks="a1_beam" methods="masa sa" seeds="0" updates=200 jobs=$(nproc) out="" sets=() replot=0
+tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1
 while [ $# -gt 0 ]; do
   case "$1" in
     --tasks) tasks=$2; shift 2 ;;
@@ -19,75 +29,142 @@ while [ $# -gt 0 ]; do
     --seeds) seeds=$2; shift 2 ;;
     --updates) updates=$2; shift 2 ;;
     --jobs) jobs=$2; shift 2 ;;
+    --threads) threads=$2; shift 2 ;;
+    --hosts) hosts=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
-    --set) sets+=(--set "$2"); shift 2 ;;
+    --set) sets+=("$2"); shift 2 ;;
+    --no-recipe) recipe=0; shift ;;
     --replot) replot=1; shift ;;
-    *) echo "grid.sh: unknown option '$1'" >&2; exit 2 ;;
+    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+[ -n "$out" ] && out=$(abs "$out")
+[ -n "$hosts" ] && hosts=$(abs "$hosts")
 build=${MASA_BUILD_DIR:-build}
-train="$build/tools/masa_train"
-if [ "$replot" = 1 ]; then
-  [ -n "$out" ] && [ -d "$out" ] || { echo "grid.sh: --replot needs --out with an existing grid" >&2; exit 2; }
+[ -x "$build/tools/masa_train" ] || { echo "grid.sh: $build/tools/masa_train is missing: run deploy/build.sh first" >&2; exit 2; }
+
+# The grid's definition is kept in DIR/grid.txt: a rerun with --out DIR and no grid options
+# continues it, and a rerun that names a different grid for the same DIR is refused.
+if [ -n "$out" ] && [ -f "$out/grid.txt" ]; then
+  # shellcheck disable=SC1091
+  saved=$(cat "$out/grid.txt")
+  g_tasks=$(sed -n 's/^tasks=//p' <<< "$saved"); g_methods=$(sed -n 's/^methods=//p' <<< "$saved")
+  g_seeds=$(sed -n 's/^seeds=//p' <<< "$saved"); g_updates=$(sed -n 's/^updates=//p' <<< "$saved")
+  g_recipe=$(sed -n 's/^recipe=//p' <<< "$saved"); g_sets=$(sed -n 's/^set=//p' <<< "$saved")
+  for k in tasks methods seeds updates; do
+    want=${!k}; have=$(eval echo "\$g_$k")
+    if [ -n "$want" ] && [ "$want" != "$have" ]; then
+      echo "grid.sh: $out is the grid $k='$have', not '$want' (use another --out)" >&2; exit 2
+    fi
+  done
+  if [ ${#sets[@]} -gt 0 ] && [ "$(printf '%s\n' "${sets[@]}")" != "$g_sets" ]; then
+    echo "grid.sh: $out was made with other --set options:"$'\n'"$g_sets" >&2; exit 2
+  fi
+  tasks=$g_tasks methods=$g_methods seeds=$g_seeds updates=$g_updates recipe=$g_recipe
+  mapfile -t sets < <(printf '%s' "$g_sets" | sed '/^$/d')
+elif [ "$replot" = 1 ]; then
+  echo "grid.sh: --replot needs --out with an existing grid (its grid.txt)" >&2; exit 2
 else
-  [ -x "$train" ] || { echo "grid.sh: $train is missing: run deploy/build.sh first" >&2; exit 2; }
+  tasks=${tasks:-a1_beam} methods=${methods:-masa sa} seeds=${seeds:-0}
   out=${out:-experiments/results/grid_$(date +%Y%m%d_%H%M%S)}
   mkdir -p "$out"
+  { echo "tasks=$tasks"; echo "methods=$methods"; echo "seeds=$seeds"; echo "updates=$updates"
+    echo "recipe=$recipe"; for x in "${sets[@]+"${sets[@]}"}"; do echo "set=$x"; done
+    echo "# started $(date -u +%FT%TZ) at commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  } > "$out/grid.txt"
+fi
+out=$(cd "$out" && pwd)
 
-  # One line per run; xargs runs them `jobs` at a time, each on one thread.
-  runs="$out/runs.txt"
-  : > "$runs"
-  for t in $tasks; do for m in $methods; do for s in $seeds; do echo "$t $m $s" >> "$runs"; done; done; done
-  total=$(wc -l < "$runs")
-  echo "grid.sh: $total runs ($tasks / $methods / seeds $seeds), $updates updates each, $jobs at a time, into $out"
-  printf '%s\n' "${sets[@]+"${sets[@]}"}" > "$out/sets.txt"
+if [ "$replot" = 0 ]; then
+  # The queue: one line per run, seeds outermost. Workers take lines under a lock.
+  queue="$out/.queue" lock="$out/.queue.lock"
+  : > "$queue"
+  total=0 finished=0
+  for s in $seeds; do for t in $tasks; do for m in $methods; do
+    total=$((total + 1))
+    if [ -f "$out/$t/${m}_s$s/done" ]; then finished=$((finished + 1)); else echo "$t $m $s" >> "$queue"; fi
+  done; done; done
+  # Slots: one "host" line per slot.
+  slots="$out/.slots"
+  if [ -n "$hosts" ]; then
+    [ -f "$hosts" ] || { echo "grid.sh: no hosts file $hosts" >&2; exit 2; }
+    awk '!/^[[:space:]]*(#|$)/ { n = ($2 == "" ? 1 : $2); for (i = 0; i < n; ++i) print $1 }' "$hosts" > "$slots"
+  else
+    jobs=${jobs:-$(( $(nproc) / threads > 0 ? $(nproc) / threads : 1 ))}
+    for ((i = 0; i < jobs; ++i)); do echo localhost; done > "$slots"
+  fi
+  echo "grid.sh: $total runs ($tasks / $methods / seeds $seeds), $finished already done," \
+       "$(wc -l < "$slots") at a time, into $out"
 
-  export train updates out
+  export build repo out updates recipe threads queue lock
+  export MASA_GRID_SETS; MASA_GRID_SETS=$(printf '%s\n' "${sets[@]+"${sets[@]}"}")
+  # One run: fresh, or resumed from its checkpoint. `done` is written only when the run reached its
+  # target (masa_train exits 0 on SIGTERM too, after its checkpoint).
   run_one() {
-    local t=$1 m=$2 s=$3 dir="$out/$1/$2_s$3"
-    mapfile -t extra < "$out/sets.txt"
-    local args=()
-    for x in "${extra[@]}"; do [ -n "$x" ] && args+=("$x"); done
-    if OMP_NUM_THREADS=1 "$train" --quiet --updates "$updates" --run-dir "$dir" \
-         --set task="$t" --set method="$m" --set seed="$s" "${args[@]}" > "$dir.log" 2>&1; then
-      echo "grid.sh: done $t $m seed $s"
+    local host=$1 t=$2 m=$3 s=$4 dir="$out/$2/$3_s$4"
+    local log="$dir.log" args=(--quiet --threads "$threads")
+    [ -n "$updates" ] && args+=(--updates "$updates")
+    if [ -f "$dir/checkpoint.bin" ] && [ -f "$dir/config.yaml" ]; then
+      args+=(--resume "$dir")
     else
-      echo "grid.sh: FAILED $t $m seed $s (see $dir.log)"
+      rm -rf "$dir"
+      args+=(--run-dir "$dir")
+      [ "$recipe" = 1 ] && [ -f "configs/recipes/$t.yaml" ] && args+=(--recipe "$t")
+      args+=(--set task="$t" --set method="$m" --set seed="$s")
+      while IFS= read -r x; do [ -n "$x" ] && args+=(--set "$x"); done <<< "$MASA_GRID_SETS"
+    fi
+    local cmd; cmd="cd $(printf '%q' "$repo") && OMP_NUM_THREADS=$threads $(printf '%q ' "$build/tools/masa_train" "${args[@]}")"
+    local rc=0
+    echo "# $(date -u +%FT%TZ) on $host: $cmd" >> "$log"
+    if [ "$host" = localhost ]; then
+      bash -c "$cmd" >> "$log" 2>&1 || rc=$?
+    else
+      local ssh=${MASA_SSH:-ssh} rsync=${MASA_RSYNC:-rsync}
+      $ssh "$host" "mkdir -p $(printf '%q' "$dir")" && \
+        { [ ! -d "$dir" ] || $rsync -a "$dir/" "$host:$dir/"; } && \
+        $ssh "$host" "$cmd" >> "$log" 2>&1 || rc=$?
+      $rsync -a "$host:$dir/" "$dir/" || rc=$?
+    fi
+    # Done when the last line's update count equals the first line's target.
+    local target reached
+    target=$(sed -n 's/^masa_train: .* \([0-9][0-9]*\) updates, run dir .*/\1/p' "$log" | tail -1)
+    reached=$(sed -n 's/^masa_train: \([0-9][0-9]*\) updates, [0-9]* env steps; .*/\1/p' "$log" | tail -1)
+    if [ "$rc" = 0 ] && [ -n "$target" ] && [ "$reached" = "$target" ]; then
+      touch "$dir/done"; echo "grid.sh: done $t $m seed $s ($reached updates, $host)"
+    elif [ "$rc" = 0 ]; then
+      echo "grid.sh: stopped $t $m seed $s at ${reached:-?} of ${target:-?} updates (a rerun resumes it)"
+    else
+      echo "grid.sh: FAILED $t $m seed $s on $host (exit $rc, see $log)"
     fi
   }
-  export -f run_one
-  mkdir -p $(for t in $tasks; do echo "$out/$t"; done)
-  xargs -P "$jobs" -L 1 bash -c 'run_one "$@"' _ < "$runs"
+  worker() {
+    local host=$1 line
+    while :; do
+      line=$(flock "$lock" bash -c 'l=$(head -n 1 "$0"); [ -n "$l" ] && sed -i 1d "$0"; printf %s "$l"' "$queue")
+      [ -n "$line" ] || return 0
+      # shellcheck disable=SC2086
+      run_one "$host" $line
+    done
+  }
+  export -f run_one worker
+  for t in $tasks; do mkdir -p "$out/$t"; done
+  pids=()
+  # On a kill: the workers (no new runs) and their runs, which checkpoint and exit; the grid exits
+  # after them, so that a rerun never meets a run still writing.
+  descendants() { local c; for c in $(pgrep -P "$1"); do echo "$c"; descendants "$c"; done; }
+  stop_all() {
+    local all=("${pids[@]}") p
+    for p in "${pids[@]}"; do mapfile -t -O "${#all[@]}" all < <(descendants "$p"); done
+    kill -TERM "${all[@]}" 2>/dev/null || true
+    for p in "${all[@]}"; do while kill -0 "$p" 2>/dev/null; do sleep 0.1; done; done
+    echo "grid.sh: stopped; run the same command again (or grid.sh --out $out) to go on" >&2
+    exit 143
+  }
+  trap stop_all INT TERM
+  while read -r host; do bash -c 'worker "$0"' "$host" & pids+=($!); done < "$slots"
+  wait "${pids[@]}"
+  rm -f "$queue" "$lock" "$slots"
 fi
 
-for t in $tasks; do
-  summary="$out/$t/summary.csv"
-  echo "method,seed,env_steps,final_return" > "$summary"
-  for m in $methods; do for s in $seeds; do
-    csv="$out/$t/${m}_s$s/metrics.csv"
-    [ -f "$csv" ] || continue
-    awk -F, -v m="$m" -v s="$s" 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
-      { steps = $c["env_steps"]; r[NR] = $c["return"] }
-      END { n = 0; sum = 0; for (i = NR; i > 1 && n < 10; --i) if (r[i] != "nan") { sum += r[i]; ++n }
-            printf "%s,%s,%s,%s\n", m, s, steps, n ? sum / n : "nan" }' "$csv" >> "$summary"
-  done; done
-  # Per method: the mean over seeds of each update's return (smoothed over 5 updates) for the plot.
-  for m in $methods; do
-    files=$(for s in $seeds; do f="$out/$t/${m}_s$s/metrics.csv"; [ -f "$f" ] && echo "$f"; done)
-    [ -n "$files" ] || continue
-    awk -F, 'FNR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
-      $c["return"] != "nan" { k = FNR; steps[k] = $c["env_steps"]; sum[k] += $c["return"]; n[k]++; if (k > K) K = k }
-      END { for (k = 2; k <= K; ++k) if (n[k]) { w[k] = sum[k] / n[k] }
-            for (k = 2; k <= K; ++k) if (k in w) { s = 0; c2 = 0; for (j = k - 4; j <= k; ++j) if (j in w) { s += w[j]; ++c2 }
-                                                   printf "%s %g\n", steps[k], s / c2 } }' $files > "$out/$t/$m.dat"
-  done
-  plot=""
-  for m in $methods; do [ -s "$out/$t/$m.dat" ] && plot+="${plot:+, }\"$m.dat\" using 1:2 with lines lw 2 title \"$m\""; done
-  if command -v gnuplot > /dev/null && [ -n "$plot" ]; then
-    (cd "$out/$t" && gnuplot -e "set terminal pngcairo size 900,600; set output 'compare.png'; set termoption noenhanced;
-      set title '$t: mean episode return (mean over seeds $seeds, smoothed over 5 updates)'; set grid;
-      set xlabel 'env steps'; set ylabel 'return'; set key bottom right; plot $plot")
-  fi
-  echo "grid.sh: $t:"; column -s, -t "$summary"
-done
-echo "grid.sh: results in $out"
+"$build/tools/masa_compare" "$out"

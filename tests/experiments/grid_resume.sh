@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# experiments/grid.sh as a user meets it: a grid of 2 tiny runs killed during its first run goes
+# on from that run's checkpoint when the same command is given again (not from the start), finishes
+# both, does not redo finished runs on a third call, and draws the comparison (masa_compare).
+#   tests/experiments/grid_resume.sh BUILD_DIR WORK_DIR
+set -euo pipefail
+build=$(cd "$1" && pwd) work=$2
+src=$(cd "$(dirname "$0")/../.." && pwd)
+export MASA_BUILD_DIR=$build OMP_NUM_THREADS=1
+rm -rf "$work" && mkdir -p "$work" && cd "$work"
+fail() { echo "FAIL: $*"; for f in grid/a1_beam/*.log grid*.out; do [ -f "$f" ] && { echo "--- $f"; tail -n 20 "$f"; }; done; exit 1; }
+grid=("$src/experiments/grid.sh" --tasks a1_beam --methods "masa sa" --seeds 0 --updates 60 --jobs 1 --no-recipe
+      --out grid --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.num_envs=8
+      --set ppo.horizon=8 --set ppo.minibatch_size=64 --set env.max_episode_steps=40
+      --set runner.checkpoint_every=5 --set runner.eval_every=5 --set runner.eval_episodes=1)
+
+# 1. Killed during masa's run, after a checkpoint or two.
+"${grid[@]}" > grid1.out 2>&1 &
+pid=$!
+csv=grid/a1_beam/masa_s0/metrics.csv
+for _ in $(seq 600); do
+  [ -f "$csv" ] && [ "$(wc -l < "$csv")" -ge 12 ] && break
+  sleep 0.1
+done
+[ -f "$csv" ] && [ "$(wc -l < "$csv")" -ge 12 ] || fail "masa's run wrote no 11 updates in 60 s"
+kill -TERM "$pid"
+wait "$pid" && fail "the killed grid exited 0" || true
+[ -f grid/a1_beam/masa_s0/done ] && fail "the killed run is marked done"
+[ -f grid/a1_beam/masa_s0/checkpoint.bin ] || fail "the killed run left no checkpoint"
+rows_at_kill=$(($(wc -l < "$csv") - 1))
+[ "$rows_at_kill" -lt 60 ] || fail "masa's run finished before the kill (make the runs longer)"
+echo "killed at $rows_at_kill of 60 updates"
+
+# 2. The same command again: masa goes on from its checkpoint, sa runs, the comparison is drawn.
+"${grid[@]}" > grid2.out 2>&1 || fail "the resumed grid failed"
+grep -q "0 already done" grid2.out || fail "the resumed grid thought a run was done"
+grep -q -- "--resume .*masa_s0" grid/a1_beam/masa_s0.log || fail "masa's run was not resumed from its checkpoint"
+[ -f grid/a1_beam/masa_s0/done ] && [ -f grid/a1_beam/sa_s0/done ] || fail "a run is not marked done"
+[ "$(($(wc -l < "$csv") - 1))" -eq 60 ] || fail "masa's metrics.csv has $(($(wc -l < "$csv") - 1)) rows, not 60"
+# One row per update, no update twice: the epochs are 0..59 in order.
+awk -F, 'NR > 1 && $1 != NR - 2 { bad = 1 } END { exit bad }' "$csv" || fail "masa's epochs are not 0..59 in order"
+for f in grid/verdict.md grid/a1_beam/runs.csv grid/a1_beam/curves/return_masa.dat grid/a1_beam/curves/eval_return_sa.dat; do
+  [ -s "$f" ] || fail "no $f"
+done
+if command -v gnuplot > /dev/null; then
+  [ -s grid/a1_beam/compare.png ] && [ -s grid/compare_all.png ] || fail "no figures"
+fi
+grep -q "| sa | " grid/verdict.md || fail "the verdict has no row for sa"
+
+# 3. A third call redoes nothing and redraws the comparison.
+logs_before=$(cat grid/a1_beam/*.log | wc -l)
+rm -f grid/a1_beam/compare.png grid/verdict.md
+"${grid[@]}" > grid3.out 2>&1 || fail "the third call failed"
+grep -q "2 already done" grid3.out || fail "the third call did not see both runs done"
+[ "$(cat grid/a1_beam/*.log | wc -l)" -eq "$logs_before" ] || fail "the third call ran something again"
+[ -s grid/verdict.md ] || fail "the third call did not redo the comparison"
+# --replot, and a grid definition that differs from the directory's is refused.
+"$src/experiments/grid.sh" --replot --out grid > grid4.out 2>&1 || fail "--replot failed"
+"$src/experiments/grid.sh" --out grid --seeds "0 1" > grid5.out 2>&1 && fail "a different grid in the same directory was accepted"
+grep -q "is the grid seeds='0', not '0 1'" grid5.out || fail "the refusal does not say why: $(cat grid5.out)"
+# 4. Over a hosts file: every run goes through MASA_SSH and its directory through MASA_RSYNC (here
+# stand-ins that run on this machine and log what they were asked to do).
+cat > fake_ssh.sh <<'SH'
+host=$1; shift; echo "ssh $host $*" >> "$(dirname "$0")/remote.log"; bash -c "$*"
+SH
+cat > fake_rsync.sh <<'SH'
+echo "rsync $*" >> "$(dirname "$0")/remote.log"
+SH
+printf '# test hosts\nfar-host 2\n' > hosts
+MASA_SSH="bash $PWD/fake_ssh.sh" MASA_RSYNC="bash $PWD/fake_rsync.sh" \
+  "$src/experiments/grid.sh" --tasks a1_beam --methods "masa sa" --seeds 0 --updates 3 --no-recipe --out remote \
+  --hosts hosts --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.num_envs=8 \
+  --set ppo.horizon=8 --set ppo.minibatch_size=64 > grid6.out 2>&1 || fail "the grid over a hosts file failed"
+grep -q "2 at a time" grid6.out || fail "the hosts file's 2 slots were not used"
+[ -f remote/a1_beam/masa_s0/done ] && [ -f remote/a1_beam/sa_s0/done ] || fail "a remote run is not done"
+[ "$(grep -c '^ssh far-host .*masa_train' remote.log)" -eq 2 ] || fail "the runs did not go through ssh to far-host"
+grep -q "^rsync -a far-host:$PWD/remote/a1_beam/masa_s0/ $PWD/remote/a1_beam/masa_s0/" remote.log || \
+  fail "masa's run directory was not copied back"
+echo "PASS: killed at update $rows_at_kill, resumed to 60, finished runs not redone, comparison drawn, hosts file used"
