@@ -91,6 +91,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   }
 
   start_ = last_update_ = std::chrono::steady_clock::now();
+  silence_ = std::make_unique<SilenceWatch>(rc_.runner.silence_warn_s, start_);
   publishParams();
 }
 
@@ -126,6 +127,7 @@ void Learner::onChunk(const void* data, int size) {
   const transport::Verdict v = assembler_->acceptEncoded(data, size);
   if (!v) return;  // counted by the assembler
   const auto& m = v.chunk->msg();
+  silence_->heard(m.actor_id, std::chrono::steady_clock::now());
   if (!collector_) {
     transport::CollectorConfig c;
     c.num_envs = rc_.ppo.num_envs;
@@ -150,6 +152,7 @@ bool Learner::step(int timeout_ms) {
   }
   const auto now = std::chrono::steady_clock::now();
   if (std::chrono::duration<double>(now - last_publish_).count() >= rc_.runner.republish_every_s) publishParams();
+  if (auto warning = silence_->check(now, epoch_, droppedChunks())) std::cerr << *warning << "\n";
   return updated;
 }
 

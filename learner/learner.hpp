@@ -29,6 +29,7 @@
 #include "learner/learning_curve.hpp"
 #include "learner/ppo/ppo_trainer.hpp"
 #include "learner/ppo/rollout_buffer.hpp"
+#include "learner/silence_watch.hpp"
 
 namespace masa::learner {
 
@@ -115,6 +116,7 @@ class Learner {
 
   std::unique_ptr<transport::Transport> transport_;
   std::unique_ptr<transport::RolloutAssembler> assembler_;  // made once the run id is known
+  std::unique_ptr<SilenceWatch> silence_;
   // Made on the first accepted chunk: the reward term names come from the actors' task.
   std::unique_ptr<transport::BatchCollector> collector_;
   transport::RolloutBatch batch_;

@@ -312,6 +312,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   u.plot_every = r.atLeast("runner.plot_every", 0);
   u.eval_every = r.atLeast("runner.eval_every", 0);
   u.eval_episodes = r.atLeast("runner.eval_episodes", 1);
+  u.silence_warn_s = r.nonNegative("runner.silence_warn_s");
 
   rc.env = YAML::Clone(merged["env"]);
   rc.resolved = merged;

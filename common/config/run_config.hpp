@@ -47,6 +47,7 @@ struct RunnerConfig {
   int plot_every = 10;             // updates between learning-curve renders (0: only on exit)
   int eval_every = 50;             // updates between evaluations of the policy mean (0: never)
   int eval_episodes = 8;           // episodes per evaluation
+  double silence_warn_s = 30.0;    // seconds without rollout data before the learner says so (0: never)
 };
 
 struct RunConfig {

@@ -3,7 +3,8 @@
 #  1. actor 1 is killed (SIGKILL) mid-run: the learner goes on making updates with actor 0 alone;
 #  2. actor 1 is started again with the same id: the learner reports it restarted, drops none of
 #     its chunks as duplicates, and, once actor 0 is killed too, keeps updating on actor 1's data
-#     alone, which shows that the restarted actor's chunks are accepted and trained on.
+#     alone, which shows that the restarted actor's chunks are accepted and trained on;
+#  3. actor 1 is killed too: the learner says that no data arrives and names both actors.
 #   MASA_BUILD_DIR=build bash tests/integration/actor_kill_restart.sh [PORT]
 # Prints PASS and exits 0, or prints FAIL with the logs' tails and exits 1. About 30-60 s.
 set -euo pipefail
@@ -19,7 +20,7 @@ trap 'kill_started' EXIT
 require_binaries
 
 log "learner and actors 0, 1 on $url (work dir $work)"
-start_learner "$run" "$url" "$run_id"
+start_learner "$run" "$url" "$run_id" --set runner.silence_warn_s=6
 start_actor 0 "$url" "$run_id"
 actor0=$actor_pid
 start_actor 1 "$url" "$run_id"
@@ -49,9 +50,18 @@ if grep -q "(duplicate)" "$work/learner.log"; then
   fail "the learner dropped chunks as duplicates: the restarted actor was taken for a replay"
 fi
 
+log "PASS part 2: restarted actor 1 rejoined; $(( $(updates_in "$run") - n )) updates on its data alone"
+
+# 3. Every actor dead: the learner says so, with the actors it last heard from.
+actor1=$actor_pid
+kill -KILL "$actor1"
+wait "$actor1" 2>/dev/null || true
+wait_until 20 "the learner to say that no data arrives and name actors 0 and 1" \
+  grep -qE "no rollout data for [0-9]+ s \(at update [0-9]+\); last heard from actor 0 [0-9]+ s ago \([0-9]+ chunks\), actor 1" "$work/learner.log"
+log "PASS part 3: $(grep -m1 "no rollout data" "$work/learner.log")"
+
 kill -INT "$learner_pid"
 wait "$learner_pid" || fail "the learner did not exit cleanly on SIGINT"
 grep -q "checkpoint written" "$work/learner.log" || fail "the learner did not checkpoint on SIGINT"
-log "PASS part 2: restarted actor 1 rejoined; $(( $(updates_in "$run") - n )) updates on its data alone"
-echo "PASS: killed actor tolerated, restarted actor accepted again ($(updates_in "$run") updates in all)"
+echo "PASS: killed actor tolerated, restarted actor accepted again, silence reported ($(updates_in "$run") updates in all)"
 rm -rf "$work"

@@ -59,9 +59,11 @@ wait_until() {
 
 at_least_updates() { [ "$(updates_in "$1")" -ge "$2" ]; }
 
-# start_learner RUN_DIR URL RUN_ID: a learner in the background, log in RUN_DIR/../learner.log.
+# start_learner RUN_DIR URL RUN_ID [extra args...]: a learner in the background, log in RUN_DIR/../learner.log.
 start_learner() {
-  "$learner_bin" "${test_sets[@]}" --url "$2" --run-id "$3" --run-dir "$1" --max-updates 100000 \
+  local dir=$1 url=$2 rid=$3
+  shift 3
+  "$learner_bin" "${test_sets[@]}" --url "$url" --run-id "$rid" --run-dir "$dir" --max-updates 100000 "$@" \
     > "$work/learner.log" 2>&1 &
   learner_pid=$!
   started_pids+=("$learner_pid")

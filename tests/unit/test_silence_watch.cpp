@@ -1,0 +1,45 @@
+// The learner's word when rollout data stops: after the bound, naming the actors last heard.
+#include <gtest/gtest.h>
+
+#include "learner/silence_watch.hpp"
+
+using masa::learner::SilenceWatch;
+using std::chrono::seconds;
+
+TEST(SilenceWatch, SaysNothingWhileDataArrivesAndNamesTheActorsOnceItStops) {
+  const auto t0 = SilenceWatch::Clock::time_point{};
+  SilenceWatch w(30.0, t0);
+  w.heard(0, t0 + seconds(1));
+  w.heard(1, t0 + seconds(2));
+  w.heard(0, t0 + seconds(10));
+  EXPECT_FALSE(w.check(t0 + seconds(39), 7, 0));  // 29 s since actor 0's last chunk
+  const auto said = w.check(t0 + seconds(41), 7, 0);
+  ASSERT_TRUE(said);
+  EXPECT_NE(said->find("no rollout data for 31 s (at update 7)"), std::string::npos) << *said;
+  EXPECT_NE(said->find("actor 0 31 s ago (2 chunks)"), std::string::npos) << *said;
+  EXPECT_NE(said->find("actor 1 39 s ago (1 chunks)"), std::string::npos) << *said;
+  EXPECT_EQ(said->find("dropped"), std::string::npos) << *said;
+  // Once per interval while the silence lasts.
+  EXPECT_FALSE(w.check(t0 + seconds(50), 7, 0));
+  EXPECT_TRUE(w.check(t0 + seconds(72), 7, 0));
+  // Data again: quiet until a new silence of 30 s.
+  w.heard(1, t0 + seconds(80));
+  EXPECT_FALSE(w.check(t0 + seconds(100), 8, 0));
+  EXPECT_TRUE(w.check(t0 + seconds(111), 8, 0));
+}
+
+TEST(SilenceWatch, NoActorYetAndChunksDroppedDuringTheSilenceAreSaid) {
+  const auto t0 = SilenceWatch::Clock::time_point{};
+  SilenceWatch w(5.0, t0);
+  EXPECT_FALSE(w.check(t0 + seconds(1), 0, 100));  // 100 drops before the silence: not counted
+  const auto said = w.check(t0 + seconds(6), 0, 160);
+  ASSERT_TRUE(said);
+  EXPECT_NE(said->find("no actor heard from yet"), std::string::npos) << *said;
+  EXPECT_NE(said->find("60 chunks dropped meanwhile"), std::string::npos) << *said;
+}
+
+TEST(SilenceWatch, ZeroNeverWarns) {
+  const auto t0 = SilenceWatch::Clock::time_point{};
+  SilenceWatch w(0.0, t0);
+  EXPECT_FALSE(w.check(t0 + seconds(100000), 0, 0));
+}
