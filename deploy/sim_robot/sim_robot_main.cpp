@@ -101,10 +101,12 @@ int main(int argc, char** argv) {
     const auto wall = [&] { return std::chrono::duration<double>(Clock::now() - t_start).count(); };
     std::deque<Pending> pending;
     int64_t received = 0, lost_commands = 0, lost_states = 0;
+    std::vector<int64_t> runners;  // ids of the runners heard
     masa::lcmt_robot_command incoming{};
     lcm.subscribeRaw(command_channel, [&](const void* data, int size) {
       if (transport::decodeChecked(data, size, incoming) != transport::WireVerdict::kOk || incoming.num_joints != n) return;
       ++received;
+      if (std::find(runners.begin(), runners.end(), incoming.runner_id) == runners.end()) runners.push_back(incoming.runner_id);
       if (loss > 0 && unit(fault) < loss) {
         ++lost_commands;
         return;
@@ -215,6 +217,7 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_until(t0 + std::chrono::duration<double>(t));
     }
     mj_kinematics(m, d);
+    std::printf("masa_sim_robot: commands from %zu runner(s)\n", runners.size());
     std::printf("masa_sim_robot: %.2f s simulated, %lld commands received (%lld lost), %lld states lost; command modes:"
                 " calibrating %lld, policy %lld, damping %lld, hold %lld, estop %lld physics steps\n",
                 steps * dt, static_cast<long long>(received), static_cast<long long>(lost_commands),
