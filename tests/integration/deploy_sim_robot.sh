@@ -40,7 +40,7 @@ case "$case_name" in
 walk)
   steps=250
   "$sim" "$policy" --seed 0 --duration 6.5 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
-  "$deploy" "$policy" --config "$config" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
   rc=$?
   wait "${pids[0]}"
   [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
@@ -61,7 +61,8 @@ stale|nan)
   if [ "$case_name" = stale ]; then fault=(--stop-state-after 1.5); bound_s=0.12; want="no new state"
   else fault=(--nan-state-after 1.5); bound_s=0.05; want="state not finite"; fi
   "$sim" "$policy" --seed 0 --duration 3 --quiet "${fault[@]}" > "$work/sim.log" 2>&1 & pids+=($!)
-  "$deploy" "$policy" --config "$config" --exit-on-trip --quiet > "$work/deploy.log" 2>&1
+  # A runner that never trips would run on: timeout ends it (rc 124).
+  timeout -s INT 10 "$deploy" "$policy" --config "$config" --exit-on-trip --quiet > "$work/deploy.log" 2>&1
   rc=$?
   wait "${pids[0]}"
   [ $rc -eq 4 ] || fail "masa_deploy exited with $rc, expected 4 (tripped)"
@@ -78,7 +79,7 @@ second_runner)
   "$sim" "$policy" --seed 0 --duration 4 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
   "$deploy" "$policy" --config "$config" --duration 3 --quiet > "$work/first.log" 2>&1 & pids+=($!)
   sleep 1.5
-  "$deploy" "$policy" --config "$config" --set start_guard_s=0.5 --quiet > "$work/second.log" 2>&1
+  timeout -s INT 5 "$deploy" "$policy" --config "$config" --set start_guard_s=0.5 --quiet > "$work/second.log" 2>&1
   rc=$?
   [ $rc -eq 3 ] || fail "the second runner exited with $rc, expected 3 (refused)"
   grep -q "REFUSED: another runner" "$work/second.log" || fail "the second runner did not say why"

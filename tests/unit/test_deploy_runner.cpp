@@ -191,6 +191,7 @@ TEST(DeployRunner, LimitsHoldOnEveryCommandForRandomPolicies) {
     c.max_target_rate = 5.0;  // tight enough to bind
     c.action_clip = 3.0;      // the task clamps to 1 anyway
     c.max_kp = 30;            // below the A1's 40: must bind
+    c.position_margin = 0.4;  // hips +-0.403 rad: the A1's targets (stand +-0.4, +-0.25 per action) exceed it
     PolicyRunner r(f.lp, c, 1);
     std::normal_distribution<double> noise(0.0, 1.0);
     masa::lcmt_robot_command cmd = r.makeCommand();
