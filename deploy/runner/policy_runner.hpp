@@ -71,6 +71,7 @@ class PolicyRunner {
   // Receive time of the state the last command answered (0: none, e.g. a watchdog command).
   int64_t lastAnsweredRxUs() const { return answered_rx_us_; }
 
+  bool hasState() const { return have_state_; }
   int64_t statesReceived() const { return states_received_; }
   int64_t statesIgnored() const { return states_ignored_; }
 

@@ -136,6 +136,7 @@ int main(int argc, char** argv) {
       const int64_t now = steadyMicros();
       const bool end_by_time = duration_s > 0 && now - t0 >= static_cast<int64_t>(duration_s * 1e6);
       const bool end_by_steps = max_policy_steps > 0 && runner.policySteps() >= max_policy_steps;
+      if ((g_stop || end_by_time) && !runner.hasState()) break;  // no robot heard: nothing to make safe
       if (g_stop || end_by_time || end_by_steps) {
         runner.stop(end_by_steps ? deploy::Mode::kHold : cfg.safe_mode == deploy::SafeMode::kHold ? deploy::Mode::kHold : deploy::Mode::kDamping,
                     g_stop ? "stopped by signal" : end_by_steps ? "policy step limit reached" : "--duration reached");

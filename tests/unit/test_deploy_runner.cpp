@@ -217,9 +217,10 @@ TEST(DeployRunner, LimitsHoldOnEveryCommandForRandomPolicies) {
         ASSERT_LE(cmd.kp[k], c.max_kp);
         ASSERT_GE(cmd.kd[k], 0.0);
         ASSERT_LE(cmd.kd[k], c.max_kd);
-        if (cmd.mode == static_cast<int>(Mode::kPolicy) && !prev.empty())
+        if (cmd.mode == static_cast<int>(Mode::kPolicy) && !prev.empty()) {
           ASSERT_LE(std::abs(cmd.position[k] - prev[k]), c.max_target_rate * (t - last_t) * 1e-6 + 1e-12)
               << "joint " << k << " moved too fast at " << t;
+        }
       }
       policy_commands += cmd.mode == static_cast<int>(Mode::kPolicy);
       prev.assign(cmd.position.begin(), cmd.position.end());
