@@ -161,6 +161,11 @@ std::string resolveRecipe(const std::string& configs_dir, const std::string& nam
 
 }  // namespace
 
+void overlayChecked(YAML::Node dst, const YAML::Node& src, const YAML::Node& schema, const std::string& file,
+                    std::map<std::string, std::string>& origin) {
+  overlay(dst, src, schema, "", file, origin);
+}
+
 std::string defaultConfigsDir() {
   if (const char* env = std::getenv("MASA_CONFIGS")) return env;
   return std::string(MASA_SOURCE_DIR) + "/configs";

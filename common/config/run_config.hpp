@@ -78,6 +78,12 @@ RunConfig loadRunConfigText(const std::string& configs_dir, const std::string& y
 RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<std::string>& overrides,
                             const YAML::Node& base, const std::string& base_file);
 
+// Overlays `src` (read from `file`) onto `dst`, a clone of `schema`: a key the schema does not have,
+// or a map where a value belongs (and the reverse), is a ConfigError naming `file` and the key
+// path. Records in `origin` which file set each key. The rule of run configs, for other configs.
+void overlayChecked(YAML::Node dst, const YAML::Node& src, const YAML::Node& schema, const std::string& file,
+                    std::map<std::string, std::string>& origin);
+
 // The configs directory of this source tree (MASA_SOURCE_DIR/configs) unless MASA_CONFIGS is set.
 std::string defaultConfigsDir();
 

@@ -40,6 +40,13 @@ Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::Symm
     for (int k = 0; k < actDim(); ++k)
       effort_ratio_[k] = max_gear > 0 ? std::abs(m->actuator_gear[6 * action_actuator_[k]]) / max_gear : 1.0;
   }
+  for (const auto& fj : spec_.mujoco().free_joints) {
+    if (fj.kind != sym::FreeJointKind::kRobotBase) continue;
+    const int j = model_->id(mjOBJ_JOINT, fj.name);
+    if (model_->get()->jnt_type[j] != mjJNT_FREE) continue;  // reported by the verifier
+    base_qadr_ = model_->get()->jnt_qposadr[j];
+    base_vadr_ = model_->get()->jnt_dofadr[j];
+  }
   last_action_.assign(actDim(), 0.0);
   action_scratch_.assign(actDim(), 0.0);
   qpos_scratch_.assign(model_->get()->nq, 0.0);
@@ -80,6 +87,37 @@ void Task::reset(Rng& rng) {
 }
 
 void Task::observe(float* out) const { writeObservation(out); }
+
+void Task::setMeasuredState(const double* joint_pos, const double* joint_vel, const double* base_pose7,
+                            const double* base_vel6, const double* last_action) {
+  const mjModel* m = model_->get();
+  for (int k = 0; k < actDim(); ++k) {
+    const int j = action_joint_[k];
+    MASA_CHECK(j >= 0, "action " << k << " drives no joint: no measured state for it");
+    data_->qpos[m->jnt_qposadr[j]] = joint_pos[k];
+    data_->qvel[m->jnt_dofadr[j]] = joint_vel[k];
+    last_action_[k] = last_action[k];
+  }
+  if (base_qadr_ >= 0 && base_pose7 != nullptr) std::copy(base_pose7, base_pose7 + 7, data_->qpos + base_qadr_);
+  if (base_vadr_ >= 0 && base_vel6 != nullptr) std::copy(base_vel6, base_vel6 + 6, data_->qvel + base_vadr_);
+  mj_kinematics(m, data_);
+  mj_comPos(m, data_);
+}
+
+std::string Task::measuredStateGap() const {
+  const mjModel* m = model_->get();
+  std::vector<char> measured(m->njnt, 0);
+  for (int k = 0; k < actDim(); ++k)
+    if (action_joint_[k] >= 0) measured[action_joint_[k]] = 1;
+  for (int j = 0; j < m->njnt; ++j) {
+    if (measured[j] || (m->jnt_qposadr[j] == base_qadr_ && base_qadr_ >= 0)) continue;
+    const char* n = mj_id2name(m, mjOBJ_JOINT, j);
+    return "joint '" + std::string(n ? n : "?") + "' is neither driven by an action nor the robot base";
+  }
+  for (int k = 0; k < actDim(); ++k)
+    if (action_joint_[k] < 0) return "action " + std::to_string(k) + " drives no joint";
+  return "";
+}
 
 void Task::applyAction(const double* action) {
   const mjModel* m = model_->get();

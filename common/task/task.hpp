@@ -78,6 +78,31 @@ class Task {
   // Copies the full state (simulator and task extras) of another instance of the same task.
   void copyStateFrom(const Task& other);
 
+  // --- deployment: a robot's measured state in place of the simulator's own (masa_deploy) ---
+  // The joint command the task's actuation turns `action` (action order, clamped to [-1, 1]) into,
+  // for a robot that runs per joint  torque = kp (position - q) + kd (velocity - qdot) + torque_ff.
+  // Each output holds actDim() values. False when the task's actuation is not such a per-joint
+  // law (the default): such a task cannot be deployed by masa_deploy.
+  virtual bool jointCommand(const double* action, double* position, double* velocity, double* torque_ff, double* kp,
+                            double* kd) const {
+    return false;
+  }
+  // Writes a measured state into data() the way the simulator holds it, then refreshes body poses
+  // as step() does, so that observe() builds the observation by the task's own code: joint angles
+  // and velocities (action order), the robot base (spec mujoco.free_joints, kind robot_base) as
+  // position, quaternion (w, x, y, z), world linear and body angular velocity (null: left as they
+  // are), and the last action (action order, what the task records after clamping).
+  void setMeasuredState(const double* joint_pos, const double* joint_vel, const double* base_pose7,
+                        const double* base_vel6, const double* last_action);
+  // "" when the observation depends only on what setMeasuredState writes, else why not (a joint
+  // that no action drives and that is not the robot base: a ball, a cube).
+  std::string measuredStateGap() const;
+  bool hasRobotBase() const { return base_qadr_ >= 0; }
+  // The task's termination test on the current state (a fall), without stepping.
+  bool terminatedNow() const { return isTerminated(); }
+  int actuatorOfAction(int k) const { return action_actuator_[k]; }
+  int jointOfAction(int k) const { return action_joint_[k]; }
+
   const mjModel* model() const { return model_->get(); }
   const mjData* data() const { return data_; }
   mjData* data() { return data_; }
@@ -111,8 +136,6 @@ class Task {
   virtual void copyExtrasFrom(const Task& other) {}
 
   // --- helpers for tasks ---
-  int actuatorOfAction(int k) const { return action_actuator_[k]; }
-  int jointOfAction(int k) const { return action_joint_[k]; }
   int frameSkip() const { return frame_skip_; }
   // The paper's "joints power consumption" in the convention its weights were tuned for
   // (IsaacGym's electricity cost): sum over actions of |a_k * qdot_k| * energy_velocity_scale * w_k,
@@ -142,6 +165,7 @@ class Task {
   std::vector<double> weights_;
   std::vector<double> terms_, raw_terms_;
   std::vector<int> action_actuator_, action_joint_;
+  int base_qadr_ = -1, base_vadr_ = -1;  // the robot base free joint's qpos / qvel address
   std::vector<double> last_action_, action_scratch_;
   std::vector<double> qpos_scratch_, qvel_scratch_, ctrl_scratch_;
   EpisodeStats episode_;

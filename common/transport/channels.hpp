@@ -8,5 +8,8 @@ inline constexpr const char* kRolloutChannel = "MASA_ROLLOUT";           // lcmt
 inline constexpr const char* kPolicyChannel = "MASA_POLICY";             // lcmt_policy_params
 inline constexpr const char* kLearnerStatsChannel = "MASA_LEARNER_STATS";  // lcmt_learner_stats
 inline constexpr const char* kHeartbeatChannel = "MASA_ACTOR_HEARTBEAT";   // lcmt_actor_heartbeat
+// A robot and its policy runner (masa_deploy, masa_sim_robot); the deploy config may rename them.
+inline constexpr const char* kRobotStateChannel = "MASA_ROBOT_STATE";      // lcmt_robot_state
+inline constexpr const char* kRobotCommandChannel = "MASA_ROBOT_COMMAND";  // lcmt_robot_command
 
 }  // namespace masa::transport

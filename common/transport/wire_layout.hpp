@@ -17,6 +17,8 @@ class lcmt_rollout_chunk;
 class lcmt_policy_params;
 class lcmt_learner_stats;
 class lcmt_actor_heartbeat;
+class lcmt_robot_state;
+class lcmt_robot_command;
 }  // namespace masa
 
 namespace masa::transport {
@@ -126,6 +128,40 @@ struct WireLayoutOf<masa::lcmt_rollout_chunk> {
       {"term_names", WireType::kString, "num_terms"},
       {"term_sums_len", WireType::kInt32},
       {"episode_term_sums", WireType::kFloat, "term_sums_len"},
+  };
+};
+
+template <>
+struct WireLayoutOf<masa::lcmt_robot_state> {
+  static constexpr WireField fields[] = {
+      {"utime", WireType::kInt64},
+      {"num_joints", WireType::kInt32},
+      {"joint_position", WireType::kDouble, "num_joints"},
+      {"joint_velocity", WireType::kDouble, "num_joints"},
+      {"joint_torque", WireType::kDouble, "num_joints"},
+      {"has_base", WireType::kBoolean},
+      {"base_x", WireType::kDouble},  {"base_y", WireType::kDouble},  {"base_z", WireType::kDouble},
+      {"base_qw", WireType::kDouble}, {"base_qx", WireType::kDouble}, {"base_qy", WireType::kDouble},
+      {"base_qz", WireType::kDouble},
+      {"base_vx", WireType::kDouble}, {"base_vy", WireType::kDouble}, {"base_vz", WireType::kDouble},
+      {"base_wx", WireType::kDouble}, {"base_wy", WireType::kDouble}, {"base_wz", WireType::kDouble},
+  };
+};
+
+template <>
+struct WireLayoutOf<masa::lcmt_robot_command> {
+  static constexpr WireField fields[] = {
+      {"utime", WireType::kInt64},
+      {"state_utime", WireType::kInt64},
+      {"runner_id", WireType::kInt64},
+      {"sequence", WireType::kInt64},
+      {"mode", WireType::kInt8},
+      {"num_joints", WireType::kInt32},
+      {"position", WireType::kDouble, "num_joints"},
+      {"velocity", WireType::kDouble, "num_joints"},
+      {"torque_ff", WireType::kDouble, "num_joints"},
+      {"kp", WireType::kDouble, "num_joints"},
+      {"kd", WireType::kDouble, "num_joints"},
   };
 };
 

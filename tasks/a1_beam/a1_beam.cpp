@@ -134,6 +134,19 @@ class A1Beam final : public Task {
     out[1] = t > 0 ? x / t : 0.0;
   }
 
+  // The PD law of beforeSubstep() as a robot's joint command: targets around the stand pose.
+  bool jointCommand(const double* action, double* position, double* velocity, double* torque_ff, double* kp,
+                    double* kd) const override {
+    for (int k = 0; k < kNumJoints; ++k) {
+      position[k] = stand_[k] + action_scale_ * std::clamp(action[k], -1.0, 1.0);
+      velocity[k] = 0.0;
+      torque_ff[k] = 0.0;
+      kp[k] = kp_;
+      kd[k] = kd_;
+    }
+    return true;
+  }
+
  protected:
   void computeRewardTerms(double* raw) const override {
     const double* q = data_->qpos + root_q_;

@@ -14,6 +14,8 @@
 #include "masa/lcmt_actor_heartbeat.hpp"
 #include "masa/lcmt_learner_stats.hpp"
 #include "masa/lcmt_policy_params.hpp"
+#include "masa/lcmt_robot_command.hpp"
+#include "masa/lcmt_robot_state.hpp"
 #include "masa/lcmt_rollout_chunk.hpp"
 #include "test_transport_support.hpp"
 
@@ -71,6 +73,8 @@ TEST(WireGuard, EveryLayoutTableMatchesLcmGensTypeHash) {
   EXPECT_EQ(lcmHashOfTable<masa::lcmt_actor_heartbeat>(), masa::lcmt_actor_heartbeat::getHash());
   EXPECT_EQ(lcmHashOfTable<masa::lcmt_learner_stats>(), masa::lcmt_learner_stats::getHash());
   EXPECT_EQ(lcmHashOfTable<masa::lcmt_rollout_chunk>(), masa::lcmt_rollout_chunk::getHash());
+  EXPECT_EQ(lcmHashOfTable<masa::lcmt_robot_state>(), masa::lcmt_robot_state::getHash());
+  EXPECT_EQ(lcmHashOfTable<masa::lcmt_robot_command>(), masa::lcmt_robot_command::getHash());
 }
 
 TEST(WireGuard, ATableWhoseLengthNamesNoEarlierIntegerFieldIsRefused) {

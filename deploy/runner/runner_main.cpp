@@ -1,0 +1,189 @@
+// masa_deploy: runs a trained policy on a robot over LCM.
+//   masa_deploy tasks/a1_beam/policy/policy.bin --config my_robot.yaml [--set watchdog.stale_after_s=0.03]
+// Reads lcmt_robot_state on lcm.state_channel, publishes lcmt_robot_command on lcm.command_channel
+// (configs/deploy/defaults.yaml). Refuses to start while another runner publishes commands; then
+// ramps to the nominal pose, hands over to the policy, and keeps the watchdog and the limits
+// (deploy/runner/policy_runner.hpp). Ctrl-C publishes the safe command before it exits.
+// Exit codes: 0 stopped (signal, --duration, --max-policy-steps), 2 error, 3 start guard refused or
+// another runner appeared, 4 stopped by the watchdog or the emergency stop (--exit-on-trip).
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "common/policy/policy_file.hpp"
+#include "common/transport/transport.hpp"
+#include "deploy/runner/deploy_config.hpp"
+#include "deploy/runner/policy_runner.hpp"
+
+using namespace masa;
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+void onSignal(int) { g_stop = true; }
+
+int64_t steadyMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Latencies from state received to command published, in microsecond bins (the last: beyond).
+class LatencyHistogram {
+ public:
+  void add(int64_t us) {
+    ++bins_[std::clamp<int64_t>(us, 0, kBins - 1)];
+    ++count_;
+  }
+  int64_t count() const { return count_; }
+  int64_t quantile(double p) const {
+    const int64_t want = static_cast<int64_t>(std::ceil(p * count_));
+    int64_t seen = 0;
+    for (int i = 0; i < kBins; ++i)
+      if ((seen += bins_[i]) >= want && want > 0) return i;
+    return 0;
+  }
+
+ private:
+  static constexpr int kBins = 100000;
+  std::vector<int64_t> bins_ = std::vector<int64_t>(kBins, 0);
+  int64_t count_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"masa_deploy: run a trained policy on a robot over LCM"};
+  std::string policy_path, config_file, url;
+  std::vector<std::string> sets;
+  double duration_s = 0;
+  int64_t max_policy_steps = 0;
+  bool quiet = false, exit_on_trip = false;
+  app.add_option("policy", policy_path, "policy file (policy.bin of a run, or a shipped one)")->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--config", config_file, "the robot's deploy config (YAML; keys of configs/deploy/defaults.yaml)");
+  app.add_option("--set", sets, "key.path=value over the config (repeatable)");
+  app.add_option("--url", url, "LCM provider URL (overrides lcm.url)");
+  app.add_option("--duration", duration_s, "stop (with the safe command) after this many seconds (0: until Ctrl-C)");
+  app.add_option("--max-policy-steps", max_policy_steps, "hold the pose and stop after this many policy commands");
+  app.add_flag("--exit-on-trip", exit_on_trip, "exit (code 4) once the watchdog or the emergency stop has tripped and its command is out");
+  app.add_flag("--quiet", quiet, "no per-second status line");
+  CLI11_PARSE(app, argc, argv);
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+
+  try {
+    const deploy::DeployConfig cfg = deploy::loadDeployConfig(config_file, sets);
+    policy::LoadedPolicy lp = policy::loadPolicyFile(policy_path);
+    const double sym_error = policy::checkPolicySymmetry(lp);
+    std::random_device rd;
+    const int64_t runner_id = static_cast<int64_t>((uint64_t{rd()} << 32) ^ rd() ^ steadyMicros()) & INT64_MAX;
+    deploy::PolicyRunner runner(lp, cfg, runner_id);
+    transport::Transport lcm(url.empty() ? cfg.lcm_url : url);
+    std::fprintf(stderr,
+                 "masa_deploy: task %s, method %s (equivariance error %.1e), %d joints, %.1f Hz, watchdog %.0f ms "
+                 "(safe command within %.0f ms), state %s, commands %s, id %lld\n",
+                 lp.config.task.c_str(), model::methodName(lp.config.method).c_str(), sym_error, runner.numJoints(),
+                 1.0 / runner.periodS(), cfg.stale_after_s * 1e3, runner.watchdogBoundS() * 1e3, cfg.state_channel.c_str(),
+                 cfg.command_channel.c_str(), static_cast<long long>(runner_id));
+
+    // Commands of other runners on our channel: the start guard, and a warning later.
+    masa::lcmt_robot_command heard = runner.makeCommand();
+    int64_t foreign = 0, foreign_id = 0;
+    lcm.subscribeRaw(cfg.command_channel, [&](const void* data, int size) {
+      if (transport::decodeChecked(data, size, heard) == transport::WireVerdict::kOk && heard.runner_id != runner_id) {
+        ++foreign;
+        foreign_id = heard.runner_id;
+      }
+    });
+    masa::lcmt_robot_state state{};
+    state.joint_position.reserve(runner.numJoints());
+    state.joint_velocity.reserve(runner.numJoints());
+    state.joint_torque.reserve(runner.numJoints());
+    int64_t rejected_states = 0;
+    lcm.subscribeRaw(cfg.state_channel, [&](const void* data, int size) {
+      const int64_t rx = steadyMicros();
+      if (transport::decodeChecked(data, size, state) != transport::WireVerdict::kOk) {
+        ++rejected_states;
+        return;
+      }
+      runner.onState(state, rx);
+    });
+
+    const int64_t guard_end = steadyMicros() + static_cast<int64_t>(cfg.start_guard_s * 1e6);
+    while (steadyMicros() < guard_end && !g_stop) lcm.handleTimeout(10);
+    if (foreign > 0) {
+      std::fprintf(stderr, "masa_deploy: REFUSED: another runner (id %lld) publishes on %s; stop it first\n",
+                   static_cast<long long>(foreign_id), cfg.command_channel.c_str());
+      return 3;
+    }
+    std::fprintf(stderr, "masa_deploy: start guard passed (%.2f s, no other runner); waiting for state on %s\n",
+                 cfg.start_guard_s, cfg.state_channel.c_str());
+
+    masa::lcmt_robot_command cmd = runner.makeCommand();
+    LatencyHistogram latency;
+    deploy::Mode shown = deploy::Mode::kCalibrating;
+    bool announced = false;
+    const int64_t t0 = steadyMicros();
+    int64_t next_status = t0 + 1000000, published = 0;
+    int exit_code = 0;
+    for (;;) {
+      const int64_t now = steadyMicros();
+      const bool end_by_time = duration_s > 0 && now - t0 >= static_cast<int64_t>(duration_s * 1e6);
+      const bool end_by_steps = max_policy_steps > 0 && runner.policySteps() >= max_policy_steps;
+      if ((g_stop || end_by_time) && !runner.hasState()) break;  // no robot heard: nothing to make safe
+      if (g_stop || end_by_time || end_by_steps) {
+        runner.stop(end_by_steps ? deploy::Mode::kHold : cfg.safe_mode == deploy::SafeMode::kHold ? deploy::Mode::kHold : deploy::Mode::kDamping,
+                    g_stop ? "stopped by signal" : end_by_steps ? "policy step limit reached" : "--duration reached");
+      }
+      if (runner.poll(now, cmd)) {
+        lcm.publish(cfg.command_channel, cmd);
+        ++published;
+        if (runner.lastAnsweredRxUs() > 0) latency.add(steadyMicros() - runner.lastAnsweredRxUs());
+        if (!announced || runner.mode() != shown) {
+          std::fprintf(stderr, "masa_deploy: %s: %s\n", deploy::modeName(runner.mode()), runner.reason().c_str());
+          shown = runner.mode();
+          announced = true;
+        }
+        if (deploy::isLatched(runner.mode()) && (g_stop || end_by_time || end_by_steps)) break;
+        if (exit_on_trip && deploy::isLatched(runner.mode())) {
+          exit_code = 4;
+          break;
+        }
+      }
+      if (foreign > 0) {
+        std::fprintf(stderr, "masa_deploy: another runner (id %lld) publishes on %s: stopping\n",
+                     static_cast<long long>(foreign_id), cfg.command_channel.c_str());
+        exit_code = 3;
+        break;
+      }
+      if (!quiet && now >= next_status) {
+        std::fprintf(stderr, "masa_deploy: %.0f s, %s, %lld states, %lld commands, %lld policy steps\n", (now - t0) * 1e-6,
+                     deploy::modeName(runner.mode()), static_cast<long long>(runner.statesReceived()),
+                     static_cast<long long>(published), static_cast<long long>(runner.policySteps()));
+        next_status += 1000000;
+      }
+      const int64_t deadline = runner.nextDeadline(steadyMicros());
+      const int64_t wait_us = std::clamp<int64_t>(deadline - steadyMicros(), 0, 20000);
+      if (lcm.handleTimeout(static_cast<int>((wait_us + 999) / 1000)) > 0) lcm.drain();
+    }
+    std::fprintf(stderr,
+                 "masa_deploy: stopped in mode %s (%s); %lld states (%lld ignored, %lld rejected by the wire guard), "
+                 "%lld commands, %lld policy steps; latency state received -> command published: p50 %lld us, "
+                 "p99 %lld us over %lld commands\n",
+                 deploy::modeName(runner.mode()), runner.reason().c_str(), static_cast<long long>(runner.statesReceived()),
+                 static_cast<long long>(runner.statesIgnored()), static_cast<long long>(rejected_states),
+                 static_cast<long long>(published), static_cast<long long>(runner.policySteps()),
+                 static_cast<long long>(latency.quantile(0.5)), static_cast<long long>(latency.quantile(0.99)),
+                 static_cast<long long>(latency.count()));
+    return exit_code;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "masa_deploy: %s\n", e.what());
+    return 2;
+  }
+}

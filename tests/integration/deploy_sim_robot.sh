@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# masa_deploy driving masa_sim_robot over real LCM (udpm, ttl=0, one port per case), the way it
+# would meet a robot. Usage: deploy_sim_robot.sh CASE PORT, CASE one of
+#   walk          the shipped A1 Beam policy walks the simulated robot at least as far as
+#                 masa_eval's episode of the same seed over as many control periods, without falling
+#   stale         the robot stops publishing state: the safe command within the watchdog's bound
+#   nan           the robot publishes NaN joint angles: the safe command within one period
+#   second_runner a second runner is refused by the start guard; the first goes on
+# Prints "PASS: ..." or "FAIL: ...".
+set -uo pipefail
+case_name=$1
+port=$2
+here=$(cd "$(dirname "$0")" && pwd)
+src=$(cd "$here/../.." && pwd)
+build=${MASA_BUILD_DIR:-$src/build}
+deploy="$build/deploy/masa_deploy"
+sim="$build/deploy/masa_sim_robot"
+eval_bin="$build/tools/masa_eval"
+policy="$src/tasks/a1_beam/policy/policy.bin"
+config="$src/configs/deploy/a1_beam_sim.yaml"
+export LCM_DEFAULT_URL="udpm://239.255.76.67:$port?ttl=0"
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  local p
+  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
+  rm -rf "$work"
+}
+trap cleanup EXIT
+fail() {
+  echo "FAIL: $*"
+  for f in "$work"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -n 20 "$f"; }; done
+  exit 1
+}
+for b in "$deploy" "$sim" "$eval_bin"; do [ -x "$b" ] || fail "$b is missing: build first"; done
+# le A B: A <= B (floating point)
+le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a <= b) }'; }
+
+case "$case_name" in
+walk)
+  steps=250
+  "$sim" "$policy" --seed 0 --duration 6.5 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
+  rc=$?
+  wait "${pids[0]}"
+  [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
+  "$eval_bin" "$policy" --episodes 1 --seed 0 --max-steps $steps > "$work/eval.log" 2>&1 || fail "masa_eval failed"
+  line=$(grep "policy phase" "$work/sim.log") || fail "the simulated robot saw no policy phase"
+  walked=$(sed -E 's/.*distance_m [-0-9.]+ -> [-0-9.]+ \(change ([-0-9.]+)\).*/\1/' <<< "$line")
+  periods=$(sed -E 's/.*\(([0-9]+) control periods.*/\1/' <<< "$line")
+  evaluated=$(awk -F'|' '$2 ~ /distance_m/ { gsub(/ /, "", $3); print $3 }' "$work/eval.log")
+  [ -n "$evaluated" ] || fail "no distance_m in masa_eval's output"
+  echo "simulated robot over LCM: $walked m in $periods control periods; masa_eval (seed 0, $steps steps): $evaluated m"
+  grep -q "fell: no" <<< "$line" || fail "the robot fell: $line"
+  [ "$periods" -ge $((steps - 1)) ] || fail "only $periods control periods under the policy, expected $steps"
+  # One control period at the task's 0.5 m/s (0.01 m): an asynchronous loop's timing resolution.
+  le "$(awk -v e="$evaluated" 'BEGIN { print e - 0.01 }')" "$walked" || fail "walked $walked m < $evaluated m - 0.01 m"
+  echo "PASS: the A1 walked $walked m over LCM (masa_eval: $evaluated m)"
+  ;;
+stale|nan)
+  if [ "$case_name" = stale ]; then fault=(--stop-state-after 1.5); bound_s=0.12; want="no new state"
+  else fault=(--nan-state-after 1.5); bound_s=0.05; want="state not finite"; fi
+  "$sim" "$policy" --seed 0 --duration 3 --quiet "${fault[@]}" > "$work/sim.log" 2>&1 & pids+=($!)
+  # A runner that never trips would run on: timeout ends it (rc 124).
+  timeout -s INT 10 "$deploy" "$policy" --config "$config" --exit-on-trip --quiet > "$work/deploy.log" 2>&1
+  rc=$?
+  wait "${pids[0]}"
+  [ $rc -eq 4 ] || fail "masa_deploy exited with $rc, expected 4 (tripped)"
+  grep -q "damping: watchdog: $want" "$work/deploy.log" || fail "masa_deploy did not say '$want'"
+  line=$(grep "first safe command" "$work/sim.log") || fail "no fault report from the simulated robot"
+  after=$(sed -nE 's/.*first safe command \(mode 2\) applied ([0-9.]+) s after it.*/\1/p' <<< "$line")
+  [ -n "$after" ] || fail "$line"
+  # The runner promises stale_after_s + one period (70 ms) for stale state, one period for NaN;
+  # the simulated robot reads commands once per physics step (5 ms): allow that and scheduling.
+  le "$after" "$bound_s" || fail "the safe command came $after s after the fault (bound $bound_s s)"
+  echo "PASS: $case_name state: damping applied $after s after the fault (bound $bound_s s)"
+  ;;
+second_runner)
+  "$sim" "$policy" --seed 0 --duration 4 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
+  "$deploy" "$policy" --config "$config" --duration 3 --quiet > "$work/first.log" 2>&1 & pids+=($!)
+  sleep 1.5
+  timeout -s INT 5 "$deploy" "$policy" --config "$config" --set start_guard_s=0.5 --quiet > "$work/second.log" 2>&1
+  rc=$?
+  [ $rc -eq 3 ] || fail "the second runner exited with $rc, expected 3 (refused)"
+  grep -q "REFUSED: another runner" "$work/second.log" || fail "the second runner did not say why"
+  wait "${pids[1]}"; rc1=$?
+  wait "${pids[0]}"
+  [ $rc1 -eq 0 ] || fail "the first runner exited with $rc1"
+  grep -q "commands from 1 runner(s)" "$work/sim.log" || fail "the robot heard more than one runner"
+  grep -q "fell: no" "$work/sim.log" || fail "the robot fell while the second runner was refused"
+  echo "PASS: the second runner was refused; the robot heard one runner"
+  ;;
+*) echo "usage: $0 walk|stale|nan|second_runner PORT"; exit 2 ;;
+esac

@@ -1,0 +1,328 @@
+// masa_deploy's runner logic (deploy/runner/policy_runner.hpp) on a simulated clock, with the A1
+// Beam policy we ship: the observation is the task's own, the watchdog answers stale and
+// non-finite state within its bound, every command keeps the limits (also for random policies),
+// the calibration ramp keeps its rate, and the control step allocates nothing. The same runner
+// against the simulated robot over real LCM: tests/integration/deploy_*.sh.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "alloc_counter.hpp"
+#include "common/core/config_error.hpp"
+#include "common/policy/policy_file.hpp"
+#include "deploy/runner/deploy_config.hpp"
+#include "deploy/runner/policy_runner.hpp"
+
+namespace masa::deploy {
+namespace {
+
+const std::string kPolicy = std::string(MASA_SOURCE_DIR) + "/tasks/a1_beam/policy/policy.bin";
+
+// A robot state message read off a simulated task, as masa_sim_robot publishes it.
+masa::lcmt_robot_state stateOf(const task::Task& t, int64_t utime) {
+  const mjModel* m = t.model();
+  const mjData* d = t.data();
+  masa::lcmt_robot_state s{};
+  s.utime = utime;
+  s.num_joints = t.actDim();
+  for (int k = 0; k < t.actDim(); ++k) {
+    const int j = t.jointOfAction(k);
+    s.joint_position.push_back(d->qpos[m->jnt_qposadr[j]]);
+    s.joint_velocity.push_back(d->qvel[m->jnt_dofadr[j]]);
+    s.joint_torque.push_back(0.0);
+  }
+  const int fj = mj_name2id(m, mjOBJ_JOINT, "trunk");
+  const double* q = d->qpos + m->jnt_qposadr[fj];
+  const double* v = d->qvel + m->jnt_dofadr[fj];
+  s.has_base = true;
+  s.base_x = q[0], s.base_y = q[1], s.base_z = q[2];
+  s.base_qw = q[3], s.base_qx = q[4], s.base_qy = q[5], s.base_qz = q[6];
+  s.base_vx = v[0], s.base_vy = v[1], s.base_vz = v[2];
+  s.base_wx = v[3], s.base_wy = v[4], s.base_wz = v[5];
+  return s;
+}
+
+struct Fixture {
+  policy::LoadedPolicy lp = policy::loadPolicyFile(kPolicy);
+  task::TaskFactory factory{lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source};
+  std::unique_ptr<task::Task> sim = factory.create();
+  Fixture() {
+    Rng rng(0);
+    sim->reset(rng);
+  }
+};
+
+DeployConfig testConfig() {
+  DeployConfig c = loadDeployConfig("");
+  c.calibration_settle_s = 0.1;
+  return c;
+}
+
+// Drives a runner with a state every `state_us` from the (still) simulated robot until `until_us`,
+// polling every 100 us; returns the commands with their times.
+struct Sent {
+  int64_t t;
+  masa::lcmt_robot_command c;
+};
+std::vector<Sent> drive(PolicyRunner& r, task::Task& sim, int64_t from_us, int64_t until_us, int64_t state_us,
+                        int64_t& utime) {
+  std::vector<Sent> out;
+  masa::lcmt_robot_command cmd = r.makeCommand();
+  for (int64_t t = from_us; t < until_us; t += 100) {
+    if (state_us > 0 && (t - from_us) % state_us == 0) r.onState(stateOf(sim, ++utime), t);
+    if (r.poll(t, cmd)) out.push_back({t, cmd});
+  }
+  return out;
+}
+
+TEST(DeployRunner, ObservationFromAStateMessageEqualsTheTasksOwnInSimulation) {
+  Fixture f;
+  std::unique_ptr<task::Task> robot_side = f.factory.create();  // never reset, never stepped
+  Rng rng(3);
+  std::normal_distribution<float> noise(0.0f, 0.5f);
+  std::vector<float> a(f.sim->actDim()), want(f.sim->obsDim()), got(f.sim->obsDim());
+  for (int t = 0; t < 20; ++t) {
+    for (float& x : a) x = noise(rng);
+    f.sim->step(a.data());
+    f.sim->observe(want.data());
+    const masa::lcmt_robot_state s = stateOf(*f.sim, t + 1);
+    const double base[13] = {s.base_x,  s.base_y,  s.base_z,  s.base_qw, s.base_qx, s.base_qy, s.base_qz,
+                             s.base_vx, s.base_vy, s.base_vz, s.base_wx, s.base_wy, s.base_wz};
+    robot_side->setMeasuredState(s.joint_position.data(), s.joint_velocity.data(), base, base + 7,
+                                 f.sim->lastAction().data());
+    robot_side->observe(got.data());
+    for (int i = 0; i < f.sim->obsDim(); ++i) ASSERT_EQ(got[i], want[i]) << "observation entry " << i << " at step " << t;
+  }
+}
+
+TEST(DeployRunner, StaleStateGivesTheSafeCommandWithinTheBoundAndSaysWhy) {
+  Fixture f;
+  PolicyRunner r(f.lp, testConfig(), 1);
+  int64_t utime = 0;
+  // 2 s of state at 200 Hz: calibration, then the policy.
+  auto sent = drive(r, *f.sim, 0, 2000000, 5000, utime);
+  ASSERT_FALSE(sent.empty());
+  for (const Sent& s : sent) ASSERT_LT(s.c.mode, 2) << "safe command while the state was fresh, at " << s.t;
+  EXPECT_EQ(sent.back().c.mode, static_cast<int>(Mode::kPolicy));
+  const int64_t last_state = 1995000;
+  // The state stops.
+  sent = drive(r, *f.sim, 2000000, 2500000, 0, utime);
+  const auto safe = std::find_if(sent.begin(), sent.end(), [](const Sent& s) { return s.c.mode >= 2; });
+  ASSERT_NE(safe, sent.end()) << "no safe command after the state stopped";
+  EXPECT_EQ(safe->c.mode, static_cast<int>(Mode::kDamping));
+  EXPECT_LE(safe->t - last_state, static_cast<int64_t>(r.watchdogBoundS() * 1e6));
+  for (int k = 0; k < r.numJoints(); ++k) EXPECT_EQ(safe->c.kp[k], 0.0);
+  EXPECT_NE(r.reason().find("no new state"), std::string::npos) << r.reason();
+  // Latched: it keeps sending the safe command, one per period, even when state comes back.
+  sent = drive(r, *f.sim, 2500000, 2700000, 5000, utime);
+  ASSERT_GE(sent.size(), 5u);
+  for (const Sent& s : sent) EXPECT_EQ(s.c.mode, static_cast<int>(Mode::kDamping));
+}
+
+TEST(DeployRunner, RepeatedStateIsStaleToo) {
+  Fixture f;
+  PolicyRunner r(f.lp, testConfig(), 1);
+  int64_t utime = 0;
+  drive(r, *f.sim, 0, 1000000, 5000, utime);
+  masa::lcmt_robot_command cmd = r.makeCommand();
+  const masa::lcmt_robot_state same = stateOf(*f.sim, utime);  // the robot SDK re-sends its last state
+  int64_t safe_at = -1;
+  for (int64_t t = 1000000; t < 1200000 && safe_at < 0; t += 100) {
+    if (t % 5000 == 0) r.onState(same, t);
+    if (r.poll(t, cmd) && cmd.mode >= 2) safe_at = t;
+  }
+  ASSERT_GT(safe_at, 0);
+  EXPECT_LE(safe_at - 995000, static_cast<int64_t>(r.watchdogBoundS() * 1e6));
+}
+
+TEST(DeployRunner, NonFiniteStateGivesTheSafeCommandAtOnce) {
+  for (const char* field : {"joint_position", "joint_velocity", "base_qx"}) {
+    Fixture f;
+    PolicyRunner r(f.lp, testConfig(), 1);
+    int64_t utime = 0;
+    drive(r, *f.sim, 0, 1500000, 5000, utime);
+    ASSERT_EQ(r.mode(), Mode::kPolicy);
+    masa::lcmt_robot_state s = stateOf(*f.sim, ++utime);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (std::string(field) == "joint_position") s.joint_position[4] = nan;
+    if (std::string(field) == "joint_velocity") s.joint_velocity[7] = std::numeric_limits<double>::infinity();
+    if (std::string(field) == "base_qx") s.base_qx = nan;
+    r.onState(s, 1500000);
+    masa::lcmt_robot_command cmd = r.makeCommand();
+    ASSERT_TRUE(r.poll(1500000, cmd)) << field;
+    EXPECT_EQ(cmd.mode, static_cast<int>(Mode::kDamping)) << field;
+    for (int k = 0; k < r.numJoints(); ++k) EXPECT_TRUE(std::isfinite(cmd.position[k])) << field;
+    EXPECT_NE(r.reason().find("not finite"), std::string::npos) << r.reason();
+  }
+}
+
+TEST(DeployRunner, EmergencyStopOnTheOrientationLimit) {
+  Fixture f;
+  PolicyRunner r(f.lp, testConfig(), 1);
+  int64_t utime = 0;
+  drive(r, *f.sim, 0, 1500000, 5000, utime);
+  masa::lcmt_robot_state s = stateOf(*f.sim, ++utime);
+  const double roll = 0.9;  // beyond the default 0.8 rad
+  s.base_qw = std::cos(roll / 2), s.base_qx = std::sin(roll / 2), s.base_qy = s.base_qz = 0;
+  r.onState(s, 1500000);
+  masa::lcmt_robot_command cmd = r.makeCommand();
+  ASSERT_TRUE(r.poll(1500000, cmd));
+  EXPECT_EQ(cmd.mode, static_cast<int>(Mode::kEmergencyStop));
+  EXPECT_NE(r.reason().find("roll"), std::string::npos) << r.reason();
+}
+
+// Every command of a runner with random networks, on random states, keeps the limits.
+TEST(DeployRunner, LimitsHoldOnEveryCommandForRandomPolicies) {
+  for (uint64_t seed : {1, 2, 3}) {
+    Fixture f;
+    Rng rng(seed);
+    std::normal_distribution<float> w(0.0f, 3.0f);  // large weights: actions far beyond [-1, 1]
+    for (int i = 0; i < f.lp.model->params().size(); ++i) f.lp.model->params().values()[i] = w(rng);
+    DeployConfig c = testConfig();
+    c.calibration_settle_s = 0;
+    c.calibration_max_rate = 50;
+    c.max_target_rate = 5.0;  // tight enough to bind
+    c.action_clip = 3.0;      // the task clamps to 1 anyway
+    c.max_kp = 30;            // below the A1's 40: must bind
+    c.position_margin = 0.4;  // hips +-0.403 rad: the A1's targets (stand +-0.4, +-0.25 per action) exceed it
+    PolicyRunner r(f.lp, c, 1);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    masa::lcmt_robot_command cmd = r.makeCommand();
+    int64_t last_t = -1, policy_commands = 0;
+    std::vector<double> prev;
+    for (int64_t t = 0, utime = 0; t < 1000000; t += 500) {
+      if (t % 5000 == 0) {
+        masa::lcmt_robot_state s = stateOf(*f.sim, ++utime);
+        for (int k = 0; k < r.numJoints(); ++k) {
+          s.joint_position[k] += 0.5 * noise(rng);
+          s.joint_velocity[k] = 5 * noise(rng);
+        }
+        s.base_y = 0.1 * noise(rng), s.base_vx = noise(rng), s.base_wz = noise(rng);
+        r.onState(s, t);
+      }
+      if (!r.poll(t, cmd)) continue;
+      for (int k = 0; k < r.numJoints(); ++k) {
+        ASSERT_TRUE(std::isfinite(cmd.position[k]));
+        ASSERT_GE(cmd.position[k], r.lowerLimit()[k]) << "joint " << k << " at " << t;
+        ASSERT_LE(cmd.position[k], r.upperLimit()[k]) << "joint " << k << " at " << t;
+        ASSERT_LE(std::abs(cmd.torque_ff[k]), r.torqueLimit()[k]);
+        ASSERT_GE(cmd.kp[k], 0.0);
+        ASSERT_LE(cmd.kp[k], c.max_kp);
+        ASSERT_GE(cmd.kd[k], 0.0);
+        ASSERT_LE(cmd.kd[k], c.max_kd);
+        if (cmd.mode == static_cast<int>(Mode::kPolicy) && !prev.empty()) {
+          ASSERT_LE(std::abs(cmd.position[k] - prev[k]), c.max_target_rate * (t - last_t) * 1e-6 + 1e-12)
+              << "joint " << k << " moved too fast at " << t;
+        }
+      }
+      policy_commands += cmd.mode == static_cast<int>(Mode::kPolicy);
+      prev.assign(cmd.position.begin(), cmd.position.end());
+      last_t = t;
+    }
+    EXPECT_GT(policy_commands, 20) << "seed " << seed;
+  }
+}
+
+TEST(DeployRunner, CalibrationRampNeverExceedsItsRateAndReachesTheNominalPose) {
+  Fixture f;
+  DeployConfig c = testConfig();
+  c.calibration_max_rate = 0.5;
+  PolicyRunner r(f.lp, c, 1);
+  // The robot lies folded: every joint at the far end of its range from the nominal pose.
+  masa::lcmt_robot_state s = stateOf(*f.sim, 1);
+  for (int k = 0; k < r.numJoints(); ++k)
+    s.joint_position[k] = r.nominalPose()[k] - r.lowerLimit()[k] > r.upperLimit()[k] - r.nominalPose()[k] ? r.lowerLimit()[k]
+                                                                                                    : r.upperLimit()[k];
+  masa::lcmt_robot_command cmd = r.makeCommand();
+  std::vector<double> prev(s.joint_position.begin(), s.joint_position.end());
+  int64_t last_t = -1, calibrating = 0;
+  bool reached = false;
+  for (int64_t t = 0; t < 8000000 && !reached; t += 1000) {
+    if (t % 2000 == 0) {
+      ++s.utime;
+      r.onState(s, t);
+    }
+    if (!r.poll(t, cmd)) continue;
+    if (cmd.mode != static_cast<int>(Mode::kCalibrating)) {
+      reached = cmd.mode == static_cast<int>(Mode::kPolicy);
+      break;
+    }
+    const double dt = last_t < 0 ? r.periodS() : (t - last_t) * 1e-6;
+    for (int k = 0; k < r.numJoints(); ++k)
+      ASSERT_LE(std::abs(cmd.position[k] - prev[k]), c.calibration_max_rate * dt + 1e-9) << "joint " << k << " at " << t;
+    prev.assign(cmd.position.begin(), cmd.position.end());
+    last_t = t;
+    ++calibrating;
+  }
+  EXPECT_TRUE(reached) << "the policy never took over";
+  for (int k = 0; k < r.numJoints(); ++k) EXPECT_NEAR(prev[k], r.nominalPose()[k], 1e-12);
+  EXPECT_GT(calibrating, 100);  // the folded pose is more than 2 s of ramp away
+}
+
+TEST(DeployRunner, ControlStepAllocatesNothing) {
+  if (!test::allocationCountingEnabled()) GTEST_SKIP() << "allocation counting disabled (sanitizer)";
+  Fixture f;
+  PolicyRunner r(f.lp, testConfig(), 1);
+  int64_t utime = 0;
+  drive(r, *f.sim, 0, 1500000, 5000, utime);
+  ASSERT_EQ(r.mode(), Mode::kPolicy);
+  masa::lcmt_robot_state s = stateOf(*f.sim, utime);
+  masa::lcmt_robot_command cmd = r.makeCommand();
+  const int64_t steps_before = r.policySteps();
+  const long before = test::allocationCount();
+  for (int64_t t = 1500000; t < 2500000; t += 500) {
+    if (t % 5000 == 0) {
+      ++s.utime;
+      r.onState(s, t);
+    }
+    r.poll(t, cmd);
+  }
+  EXPECT_EQ(test::allocationCount() - before, 0);
+  EXPECT_GE(r.policySteps() - steps_before, 45);
+}
+
+TEST(DeployConfig, UnknownKeyAndBadValueNameTheKey) {
+  const std::string dir = testing::TempDir();
+  const std::string file = dir + "/robot.yaml";
+  std::ofstream(file) << "watchdog:\n  stale_afer_s: 0.1\n";
+  try {
+    loadDeployConfig(file);
+    FAIL() << "an unknown key was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("robot.yaml: key 'watchdog.stale_afer_s': unknown key"), std::string::npos)
+        << e.what();
+  }
+  try {
+    loadDeployConfig("", {"safe.mode=limp"});
+    FAIL() << "a bad safe mode was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("command line: key 'safe.mode'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(loadDeployConfig("", {"watchdog.stale_after_s=0"}), ConfigError);
+  EXPECT_DOUBLE_EQ(loadDeployConfig("", {"limits.max_kp=12"}).max_kp, 12.0);
+}
+
+TEST(DeployRunner, TasksThatCannotRunOnARobotStateAreRefusedWithTheReason) {
+  // trifinger_lift's observation needs the cube: not in a robot state message.
+  config::RunConfig rc = config::loadRunConfig(config::defaultConfigsDir(), {"task=trifinger_lift"});
+  policy::LoadedPolicy lp;
+  lp.config = rc;
+  lp.spec = sym::SymmetrySpec::load(rc.spec_path);
+  lp.model = std::make_unique<model::ActorCritic<float>>(lp.spec, rc.model);
+  try {
+    PolicyRunner r(lp, testConfig(), 1);
+    FAIL() << "trifinger_lift was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot run on a robot's state alone"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace masa::deploy
