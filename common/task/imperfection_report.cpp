@@ -41,8 +41,10 @@ ImperfectionReport imperfectionReport(const TaskFactory& factory, const Symmetry
         joints[k] = t->actionJoints()[cd + k * ld + s];
         v[k] = joints[k] >= 0 ? value(joints[k]) : 0.0;
       }
-      double mean = 0.0;
-      for (double x : v) mean += x / n;
+      // Against the median: the one limb that differs stands alone (the mean would move the others).
+      std::vector<double> sorted = v;
+      std::sort(sorted.begin(), sorted.end());
+      const double mean = 0.5 * (sorted[(n - 1) / 2] + sorted[n / 2]);
       for (int k = 0; k < n; ++k) {
         const double rel = std::abs(v[k] - mean) / std::max(std::abs(mean), 1e-300);
         if (joints[k] < 0 || v[k] == mean) continue;
@@ -59,13 +61,13 @@ ImperfectionReport imperfectionReport(const TaskFactory& factory, const Symmetry
 
 std::string ImperfectionReport::summary(int top_k) const {
   std::ostringstream os;
-  os << "imperfection (each limb against the mean over the limbs):";
+  os << "imperfection (each limb against the median over the limbs):";
   if (entries.empty()) os << " none, every limb's parameters are equal";
   os << "\n";
   for (int k = 0; k < std::min<int>(top_k, entries.size()); ++k) {
     const Imperfection& e = entries[k];
     char buf[240];
-    std::snprintf(buf, sizeof buf, "  limb %d (%s): %s %.4g vs mean %.4g (%+.1f%%)\n", e.limb, e.joint.c_str(),
+    std::snprintf(buf, sizeof buf, "  limb %d (%s): %s %.4g vs median %.4g (%+.1f%%)\n", e.limb, e.joint.c_str(),
                   e.term.c_str(), e.value, e.mean, 100.0 * (e.value - e.mean) / (e.mean == 0 ? 1.0 : std::abs(e.mean)));
     os << buf;
   }
