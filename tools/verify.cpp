@@ -1,6 +1,7 @@
 // masa_verify: prove a symmetry spec against the physics.
 //   masa_verify --task a1_beam                       a shipped task, its spec, its config
 //   masa_verify --model my_robot.xml --spec my.yaml  a robot you bring (joints only, no task code)
+//   masa_verify ... --imperfection                   and how far from symmetric it is, limb by limb
 // Prints the verdict and the worst observation entries and joints; exit 0 on pass, 1 on fail,
 // 2 on bad input.
 #include <CLI/CLI.hpp>
@@ -9,6 +10,7 @@
 
 #include "common/config/run_config.hpp"
 #include "common/core/config_error.hpp"
+#include "common/task/imperfection_report.hpp"
 #include "common/task/symmetry_verifier.hpp"
 
 using namespace masa;
@@ -19,6 +21,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   task::SymmetryVerifierOptions opt;
   int top = 8;
+  bool imperfection = false;
   app.add_option("--task", task_name, "a registered task (uses configs/tasks/<task>.yaml and its spec)");
   app.add_option("--model", model_file, "an MJCF file of your own robot (with --spec)");
   app.add_option("--spec", spec_file, "symmetry spec (default: the task's)");
@@ -28,6 +31,8 @@ int main(int argc, char** argv) {
   app.add_option("--seed", opt.seed, "seed of the random states and actions")->capture_default_str();
   app.add_option("--tolerance", opt.tolerance, "largest error that passes")->capture_default_str();
   app.add_option("--top", top, "how many worst entries and joints to list")->capture_default_str();
+  app.add_flag("--imperfection", imperfection,
+               "also report how far from symmetric the model is, limb by limb and term by term");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -54,6 +59,7 @@ int main(int argc, char** argv) {
     }
     const auto report = task::verifySymmetry(*factory, opt);
     std::cout << report.summary(top);
+    if (imperfection) std::cout << task::imperfectionReport(*factory, opt).summary(top);
     if (!model_file.empty()) std::cout << "  (no task code: observations and rewards were not checked)\n";
     return report.passed() ? 0 : 1;
   } catch (const ConfigError& e) {

@@ -1,7 +1,7 @@
 // "mjcf": a task with no task code, for checking the symmetry of a robot a user brings (an MJCF
 // file and a spec with a `mujoco` section). It has no observation (zeros) and no reward: the
 // physics verifier then checks the joints alone, which is what names a wrong sign or limb.
-#include "common/task/registry.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::task {
 namespace {
@@ -28,13 +28,11 @@ class MjcfTask : public Task {
   double noise_;
 };
 
+}  // namespace
+
+// Listed in tasks/tasks.cpp.
 std::unique_ptr<Task> makeMjcf(std::shared_ptr<const MujocoModel> m, const sym::SymmetrySpec& s, EnvParams& p) {
   return std::make_unique<MjcfTask>(std::move(m), s, p);
 }
-
-}  // namespace
-
-// No default model: env.model_file names the user's MJCF.
-MASA_REGISTER_TASK("mjcf", "", &makeMjcf);
 
 }  // namespace masa::task

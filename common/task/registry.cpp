@@ -4,12 +4,19 @@
 #include <stdexcept>
 
 #include "common/core/config_error.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::task {
 namespace {
 
+// tasks/tasks.cpp's list, and what tests add with registerTask.
 std::map<std::string, TaskInfo>& table() {
-  static std::map<std::string, TaskInfo> t;  // function-local: safe during static registration
+  static std::map<std::string, TaskInfo> t = [] {
+    std::map<std::string, TaskInfo> listed;
+    for (const TaskInfo& info : taskList())
+      if (!listed.emplace(info.name, info).second) throw std::logic_error("task '" + info.name + "' listed twice");
+    return listed;
+  }();
   return t;
 }
 

@@ -1,6 +1,5 @@
-// Builds tasks by name. Each task registers itself from its own folder (tasks/<name>/) with
-// MASA_REGISTER_TASK; a TaskFactory then loads the model once and creates any number of
-// environments that share it.
+// Builds tasks by name. The tasks are one list, taskList() in tasks/tasks.cpp (grep it); a
+// TaskFactory loads the model once and creates any number of environments that share it.
 #pragma once
 
 #include <functional>
@@ -22,6 +21,7 @@ struct TaskInfo {
   TaskMaker make;
 };
 
+// Adds a task beyond the list (tests add their own fixtures); a name taken already is an error.
 bool registerTask(TaskInfo info);
 std::vector<std::string> registeredTasks();
 
@@ -47,9 +47,3 @@ class TaskFactory {
 };
 
 }  // namespace masa::task
-
-#define MASA_TASK_CONCAT_(a, b) a##b
-#define MASA_TASK_CONCAT(a, b) MASA_TASK_CONCAT_(a, b)
-// MASA_REGISTER_TASK("a1_beam", "tasks/a1_beam/model.xml", makerFunction)
-#define MASA_REGISTER_TASK(name, model_file, maker) \
-  static const bool MASA_TASK_CONCAT(masa_task_registered_, __LINE__) = ::masa::task::registerTask({name, model_file, maker})

@@ -66,6 +66,7 @@ std::string SymmetryReport::summary(int top_k) const {
   list("observation map obs(T s) vs T obs(s)", observation_map);
   list("observation after step", observation);
   list("joints after step", joints);
+  os << parts.summary();
   return os.str();
 }
 
@@ -127,6 +128,10 @@ SymmetryReport verifySymmetry(const TaskFactory& factory, const SymmetryVerifier
       compareJoints(m, c->data(), b->data(), report.joints);
     }
   }
+  report.parts = diagnoseSymmetry(factory, {.num_states = std::min(options.num_states, options.diagnosis_states),
+                                            .max_warmup_steps = options.max_warmup_steps,
+                                            .seed = options.seed,
+                                            .tolerance = options.tolerance});
   return report;
 }
 

@@ -5,8 +5,10 @@
 //   observation map:  obs(T_i s) = T_i obs(s)                     (the observation is equivariant)
 //   dynamics:         step(T_i s, T_i a) = T_i step(s, a)          (per joint: qpos and qvel)
 //   reward:           r(T_i s, T_i a) = r(s, a), same termination
-// and reports the worst error per observation entry and per joint, so a wrong sign or a swapped
-// limb is named. Free-joint orientations are compared as rotations (q and -q are equal).
+// and reports the worst error per observation entry and per joint. Free-joint orientations are
+// compared as rotations (q and -q are equal). The parts of the step are checked too, in order and
+// joint by joint (symmetry_diagnosis.hpp), so that a wrong sign, a swapped limb, a wrong axis or a
+// wrong group order is named at its joint with the likely fix even where the step spreads the error.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "common/task/registry.hpp"
+#include "common/task/symmetry_diagnosis.hpp"
 
 namespace masa::task {
 
@@ -21,13 +24,9 @@ struct SymmetryVerifierOptions {
   int num_states = 20;
   int max_warmup_steps = 60;  // random-action steps from reset before a state is used
   int steps = 1;              // steps compared from each state
+  int diagnosis_states = 5;   // states for the parts of the step (at most num_states)
   std::uint64_t seed = 0;
   double tolerance = 1e-6;    // pass threshold on every reported error (see docs/verifier.md)
-};
-
-struct NamedError {
-  std::string name;
-  double error = 0.0;
 };
 
 struct SymmetryReport {
@@ -39,10 +38,11 @@ struct SymmetryReport {
   double reward_error = 0.0;
   int termination_mismatches = 0;
   double tolerance = 0.0;
+  Diagnosis parts;  // the parts of the step, in order, and the culprit when one breaks
 
   double worst() const;
   bool passed() const { return worst() <= tolerance && termination_mismatches == 0; }
-  // Human-readable: verdict, then the k worst observation entries and joints.
+  // Human-readable: verdict, the k worst observation entries and joints, the parts and the culprit.
   std::string summary(int top_k = 5) const;
 };
 

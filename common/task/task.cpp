@@ -57,13 +57,35 @@ Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::Symm
 
 Task::~Task() { mj_deleteData(data_); }
 
+namespace {
+
+// The actuator a spec names: an actuator of that name, else the one actuator driving the joint of
+// that name (models whose actuators carry no names).
+int boundActuator(const MujocoModel& model, const std::string& spec_source, const std::string& name) {
+  const mjModel* m = model.get();
+  const int a = mj_name2id(m, mjOBJ_ACTUATOR, name.c_str());
+  if (a >= 0) return a;
+  const int j = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+  if (j < 0)
+    throw std::runtime_error(model.path() + ": no actuator or joint named '" + name + "' (bound in " + spec_source + ")");
+  std::vector<int> driving;
+  for (int k = 0; k < m->nu; ++k)
+    if (m->actuator_trntype[k] == mjTRN_JOINT && m->actuator_trnid[2 * k] == j) driving.push_back(k);
+  if (driving.size() != 1)
+    throw std::runtime_error(model.path() + ": joint '" + name + "' (bound in " + spec_source + ") is driven by " +
+                             std::to_string(driving.size()) + " actuators; bind an actuator by its name");
+  return driving[0];
+}
+
+}  // namespace
+
 void Task::bindActuators() {
   const mjModel* m = model_->get();
   const std::vector<std::string> names = spec_.actuatorsInActionOrder();
   MASA_CHECK(static_cast<int>(names.size()) == actDim(), "spec binds " << names.size() << " actuators to " << actDim()
                                                                        << " actions");
   for (const std::string& n : names) {
-    const int a = model_->id(mjOBJ_ACTUATOR, n);
+    const int a = boundActuator(*model_, spec_.source(), n);
     if (std::find(action_actuator_.begin(), action_actuator_.end(), a) != action_actuator_.end())
       throw std::runtime_error(spec_.source() + ": actuator '" + n + "' is bound to two actions");
     action_actuator_.push_back(a);
@@ -141,6 +163,14 @@ StepOutcome Task::step(std::span<const float> action) {
 
 void Task::advancePhysics(const float* action) {
   const mjModel* m = model_->get();
+  setControls(action);
+  for (int s = 0; s < frame_skip_; ++s) {
+    beforeSubstep();
+    mj_step(m, data_);
+  }
+}
+
+void Task::setControls(const float* action) {
   for (int k = 0; k < actDim(); ++k) {
     const double a = static_cast<double>(action[k]);
     // NaN actions become 0: a policy bug must not poison the simulator state.
@@ -148,10 +178,11 @@ void Task::advancePhysics(const float* action) {
   }
   std::copy(action_scratch_.begin(), action_scratch_.end(), last_action_.begin());
   applyAction(action_scratch_.data());
-  for (int s = 0; s < frame_skip_; ++s) {
-    beforeSubstep();
-    mj_step(m, data_);
-  }
+}
+
+void Task::actuate(const float* action) {
+  setControls(action);
+  beforeSubstep();
 }
 
 StepOutcome Task::step(const float* action) {
@@ -202,6 +233,62 @@ double Task::jointPower() const {
   return p * energy_velocity_scale_;
 }
 
+void freeJointVelocityBlocks(const sym::Group& group, int i, sym::FreeJointKind kind, Eigen::Matrix3d& linear,
+                             Eigen::Matrix3d& angular) {
+  const Eigen::Matrix3d g = sym::spatialMap(group, i);
+  linear = g;
+  // Angular velocity of a free joint is in the body frame: see task.hpp and docs.
+  if (sym::isMirror(group, i))
+    angular = -g;
+  else if (kind == sym::FreeJointKind::kRobotBase)
+    angular = g;
+  else
+    angular = Eigen::Matrix3d::Identity();  // a carried object: its body-frame angular velocity is unchanged
+}
+
+void transformFreeJoint(const sym::Group& group, int i, sym::FreeJointKind kind, double* qp, double* qv, double* qw) {
+  const Eigen::Matrix3d g = sym::spatialMap(group, i);
+  Eigen::Matrix3d lin_map, ang_map;
+  freeJointVelocityBlocks(group, i, kind, lin_map, ang_map);
+  Eigen::Map<Eigen::Vector3d> pos(qp), lin(qv), ang(qv + 3), wlin(qw), wang(qw + 3);
+  pos = g * Eigen::Vector3d(pos);
+  lin = lin_map * Eigen::Vector3d(lin);
+  wlin = lin_map * Eigen::Vector3d(wlin);
+  ang = ang_map * Eigen::Vector3d(ang);
+  wang = ang_map * Eigen::Vector3d(wang);
+  Eigen::Quaterniond q(qp[3], qp[4], qp[5], qp[6]);
+  if (sym::isMirror(group, i)) {
+    const Eigen::Vector3d v = -(g * q.vec());
+    q = Eigen::Quaterniond(q.w(), v.x(), v.y(), v.z());
+  } else {
+    const Eigen::Quaterniond pq = sym::rotationQuaternion(group, i);
+    q = kind == sym::FreeJointKind::kRobotBase ? pq * q * pq.conjugate() : pq * q;
+  }
+  qp[3] = q.w();
+  qp[4] = q.x();
+  qp[5] = q.y();
+  qp[6] = q.z();
+}
+
+Eigen::MatrixXd Task::velocityMap(int i) const {
+  const mjModel* m = model_->get();
+  const sym::SparseMap& t = spec_.actTransform(i);
+  Eigen::MatrixXd p = Eigen::MatrixXd::Zero(m->nv, m->nv);
+  for (int r = 0; r < t.rows(); ++r) {
+    const int begin = t.rowStart()[r];
+    const int jr = action_joint_[r], jc = action_joint_[t.colIndex()[begin]];
+    if (jr >= 0 && jc >= 0) p(m->jnt_dofadr[jr], m->jnt_dofadr[jc]) = t.values()[begin];
+  }
+  for (const auto& fj : spec_.mujoco().free_joints) {
+    const int d = m->jnt_dofadr[model_->id(mjOBJ_JOINT, fj.name)];
+    Eigen::Matrix3d lin, ang;
+    freeJointVelocityBlocks(spec_.group(), i, fj.kind, lin, ang);
+    p.block<3, 3>(d, d) = lin;
+    p.block<3, 3>(d + 3, d + 3) = ang;
+  }
+  return p;
+}
+
 // Hinge and slide joints follow their actuator's action entry (a signed permutation); free joints
 // follow their kind; any other joint makes the state transform undefined and is reported by name.
 void Task::transformJoints(int i) {
@@ -232,39 +319,13 @@ void Task::transformJoints(int i) {
     covered[jr] = 1;
   }
 
-  const Eigen::Matrix3d g = sym::spatialMap(spec_.group(), i);
-  const bool mirror = sym::isMirror(spec_.group(), i);
-  const Eigen::Quaterniond pq = sym::rotationQuaternion(spec_.group(), i);
   for (const auto& fj : spec_.mujoco().free_joints) {
     const int j = model_->id(mjOBJ_JOINT, fj.name);
     if (m->jnt_type[j] != mjJNT_FREE)
       throw std::runtime_error(model_->path() + ": joint '" + fj.name + "' is listed as a free joint but is not one");
     covered[j] = 1;
-    double* qp = data_->qpos + m->jnt_qposadr[j];
-    double* qv = data_->qvel + m->jnt_dofadr[j];
-    double* qw = data_->qacc_warmstart + m->jnt_dofadr[j];
-    Eigen::Map<Eigen::Vector3d> pos(qp), lin(qv), ang(qv + 3), wlin(qw), wang(qw + 3);
-    pos = g * Eigen::Vector3d(pos);
-    lin = g * Eigen::Vector3d(lin);
-    wlin = g * Eigen::Vector3d(wlin);
-    Eigen::Quaterniond q(qp[3], qp[4], qp[5], qp[6]);
-    // Angular velocity of a free joint is in the body frame: see task.hpp and docs.
-    if (mirror) {
-      const Eigen::Vector3d v = -(g * q.vec());
-      q = Eigen::Quaterniond(q.w(), v.x(), v.y(), v.z());
-      ang = -(g * Eigen::Vector3d(ang));
-      wang = -(g * Eigen::Vector3d(wang));
-    } else if (fj.kind == sym::FreeJointKind::kRobotBase) {
-      q = pq * q * pq.conjugate();
-      ang = g * Eigen::Vector3d(ang);
-      wang = g * Eigen::Vector3d(wang);
-    } else {
-      q = pq * q;  // a carried object: its body-frame angular velocity is unchanged
-    }
-    qp[3] = q.w();
-    qp[4] = q.x();
-    qp[5] = q.y();
-    qp[6] = q.z();
+    transformFreeJoint(spec_.group(), i, fj.kind, data_->qpos + m->jnt_qposadr[j], data_->qvel + m->jnt_dofadr[j],
+                       data_->qacc_warmstart + m->jnt_dofadr[j]);
   }
   for (int j = 0; j < m->njnt; ++j)
     if (!covered[j])

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "common/core/types.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/task/env_params.hpp"
@@ -38,6 +40,14 @@ struct EpisodeStats {
   bool terminated = false;
   bool truncated = false;
 };
+
+// T_i of one free joint (the spec's kinds, see docs/verifier.md): position, orientation (qpos, 7
+// values), velocity and warm start (qvel, 6 values each, angular part in the body frame).
+void transformFreeJoint(const sym::Group& group, int i, sym::FreeJointKind kind, double* qpos, double* qvel,
+                        double* warm);
+// The 3x3 blocks that act on a free joint's linear and angular velocity under T_i.
+void freeJointVelocityBlocks(const sym::Group& group, int i, sym::FreeJointKind kind, Eigen::Matrix3d& linear,
+                             Eigen::Matrix3d& angular);
 
 class Task {
  public:
@@ -107,6 +117,14 @@ class Task {
   const mjData* data() const { return data_; }
   mjData* data() { return data_; }
   const std::vector<double>& lastAction() const { return last_action_; }  // clamped, action order
+  // The MuJoCo joint each action drives (-1: none), in action order.
+  const std::vector<int>& actionJoints() const { return action_joint_; }
+  // What step() does to the controls before the first substep (clamping, applyAction, the first
+  // substep's control hook), without stepping: mj_forward then gives the actuator forces of `action`.
+  void actuate(const float* action);
+  // The joint-space map of T_i on velocities (nv x nv): qvel(T s) = P qvel(s). Generalized forces
+  // transform alike (P is orthogonal), the mass matrix as P M P^T.
+  Eigen::MatrixXd velocityMap(int i) const;
 
  protected:
   // `term_names` are the task's reward terms; their weights come from env.weights.<term>.
@@ -150,6 +168,7 @@ class Task {
 
  private:
   void bindActuators();
+  void setControls(const float* action);  // clamp, remember as the last action, applyAction
   void transformJoints(int i);
 
   std::string name_;

@@ -9,7 +9,7 @@
 
 #include "common/core/check.hpp"
 #include "common/core/config_error.hpp"
-#include "common/task/registry.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::task {
 namespace {
@@ -189,13 +189,12 @@ class A1Beam final : public Task {
   std::array<int, kNumFeet> feet_{};
 };
 
+}  // namespace
+
+// Listed in tasks/tasks.cpp.
 std::unique_ptr<Task> makeA1Beam(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
                                  EnvParams& params) {
   return std::make_unique<A1Beam>(std::move(model), spec, params);
 }
-
-}  // namespace
-
-MASA_REGISTER_TASK("a1_beam", "tasks/a1_beam/model.xml", &makeA1Beam);
 
 }  // namespace masa::task

@@ -10,7 +10,7 @@
 
 #include "common/core/check.hpp"
 #include "common/core/config_error.hpp"
-#include "common/task/registry.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::task {
 namespace {
@@ -158,13 +158,12 @@ class AntAcrobatic final : public Task {
   Free torso_, pole_, ball_;
 };
 
+}  // namespace
+
+// Listed in tasks/tasks.cpp.
 std::unique_ptr<Task> makeAntAcrobatic(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
                                        EnvParams& params) {
   return std::make_unique<AntAcrobatic>(std::move(model), spec, params);
 }
-
-}  // namespace
-
-MASA_REGISTER_TASK("ant_acrobatic", "tasks/ant_acrobatic/model.xml", &makeAntAcrobatic);
 
 }  // namespace masa::task

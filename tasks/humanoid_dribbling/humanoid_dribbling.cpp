@@ -4,7 +4,7 @@
 #include <limits>
 #include <random>
 
-#include "common/task/registry.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::task {
 
@@ -155,13 +155,10 @@ void HumanoidDribbling::copyExtrasFrom(const Task& other) {
   start_z_ = o.start_z_;
 }
 
-namespace {
+// Listed in tasks/tasks.cpp.
 std::unique_ptr<Task> makeHumanoidDribbling(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
                                             EnvParams& params) {
   return std::make_unique<HumanoidDribbling>(std::move(model), spec, params);
 }
-}  // namespace
-
-MASA_REGISTER_TASK("humanoid_dribbling", "tasks/humanoid_dribbling/model.xml", &makeHumanoidDribbling);
 
 }  // namespace masa::task

@@ -2,7 +2,7 @@
 // diameter. See README.md for the observation, the reward terms and where we differ.
 #include <cmath>
 
-#include "common/task/registry.hpp"
+#include "tasks/tasks.hpp"
 #include "tasks/humanoid_tightrope/humanoid_body.hpp"
 
 namespace masa::task {
@@ -76,13 +76,12 @@ class HumanoidTightrope final : public HumanoidTask {
   double start_z_ = 0.0, start_x_ = 0.0;  // x: along the rope, unchanged by the mirror
 };
 
+}  // namespace
+
+// Listed in tasks/tasks.cpp.
 std::unique_ptr<Task> makeHumanoidTightrope(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
                                             EnvParams& params) {
   return std::make_unique<HumanoidTightrope>(std::move(model), spec, params);
 }
-
-}  // namespace
-
-MASA_REGISTER_TASK("humanoid_tightrope", "tasks/humanoid_tightrope/model.xml", &makeHumanoidTightrope);
 
 }  // namespace masa::task

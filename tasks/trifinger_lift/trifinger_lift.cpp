@@ -14,7 +14,7 @@
 
 #include "common/core/check.hpp"
 #include "common/symmetry/group_element.hpp"
-#include "common/task/registry.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::task {
 namespace {
@@ -232,13 +232,12 @@ class TrifingerLift final : public Task {
   double prev_tip_distance_ = 0.0;
 };
 
+}  // namespace
+
+// Listed in tasks/tasks.cpp.
 std::unique_ptr<Task> makeTrifingerLift(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
                                         EnvParams& params) {
   return std::make_unique<TrifingerLift>(std::move(model), spec, params);
 }
-
-}  // namespace
-
-MASA_REGISTER_TASK("trifinger_lift", "tasks/trifinger_lift/model.xml", &makeTrifingerLift);
 
 }  // namespace masa::task
