@@ -127,20 +127,34 @@ else
   fi
 fi
 
+# Keep-alive pipe: every actor's and the learner's tethered.sh reads it on stdin, and only this
+# script holds its write end (children close it), so when this script ends in any way, even by
+# SIGKILL, each of them sees end of file and stops its program: nothing is left running, here or
+# on the hosts. Local runs and multi-host runs alike. The fifo's name is removed at once; the open ends remain.
+fifo_dir=$(mktemp -d)
+mkfifo "$fifo_dir/keepalive"
+exec {keep}<>"$fifo_dir/keepalive"
+exec {alive_in}<"$fifo_dir/keepalive"
+rm -rf "$fifo_dir"
+
 if [ -z "$hosts_file" ]; then
   echo "train.sh: $task / $method, $actors actors x $envs envs, $updates updates, run dir $run_dir"
-  "$build/learner/masa_learner" "${common[@]+"${common[@]}"}" --url "$url" --run-id "$run_id" "${learner_run[@]}" \
-    --max-updates "$updates" &
+  # The learner may be in an update when told to stop: give it time to finish and checkpoint.
+  MASA_TETHER_GRACE_S=300 bash deploy/tethered.sh "$build/learner/masa_learner" "${common[@]+"${common[@]}"}" \
+    --url "$url" --run-id "$run_id" "${learner_run[@]}" --max-updates "$updates" <&"$alive_in" {keep}>&- {alive_in}<&- &
   learner=$!
   pids=()
   for ((a = 0; a < actors; ++a)); do
-    OMP_NUM_THREADS=1 "$build/actors/masa_actor" "${actor_config[@]+"${actor_config[@]}"}" "${common[@]+"${common[@]}"}" \
-      --url "$url" --run-id "$run_id" --actor-id "$a" --num-envs "$envs" >> "$run_dir/actor$a.log" 2>&1 &
+    OMP_NUM_THREADS=1 bash deploy/tethered.sh "$build/actors/masa_actor" "${actor_config[@]+"${actor_config[@]}"}" \
+      "${common[@]+"${common[@]}"}" --url "$url" --run-id "$run_id" --actor-id "$a" --num-envs "$envs" \
+      <&"$alive_in" >> "$run_dir/actor$a.log" 2>&1 {keep}>&- {alive_in}<&- &
     pids+=($!)
   done
+  exec {alive_in}<&-
 
   stop() {
-    kill -INT "$learner" 2>/dev/null || true
+    # SIGTERM: the tethered learner's wrapper, started in the background, cannot trap SIGINT.
+    kill -TERM "$learner" 2>/dev/null || true
     wait "$learner" 2>/dev/null || true
     kill -TERM "${pids[@]}" 2>/dev/null || true
     wait "${pids[@]}" 2>/dev/null || true
@@ -158,16 +172,6 @@ fi
 read -r -a remote_shell <<< "${MASA_REMOTE_SHELL:-ssh -o BatchMode=yes}"
 remote_dir=${MASA_REMOTE_DIR:-$PWD}
 remote_build=${MASA_REMOTE_BUILD_DIR:-$build}
-
-# Keep-alive pipe: every actor's and the learner's tethered.sh reads it on stdin, and only this
-# script holds its write end (children close it), so when this script ends in any way, even by
-# SIGKILL, each of them sees end of file and stops its program: nothing is left running, here or
-# on the hosts. The fifo's name is removed at once; the open ends remain.
-fifo_dir=$(mktemp -d)
-mkfifo "$fifo_dir/keepalive"
-exec {keep}<>"$fifo_dir/keepalive"
-exec {alive_in}<"$fifo_dir/keepalive"
-rm -rf "$fifo_dir"
 
 echo "train.sh: $task / $method over $url, $actors actors on ${#hosts[@]} hosts ($total_envs envs), $updates updates, run dir $run_dir"
 # The learner may be in an update when told to stop: give it time to finish and checkpoint.
