@@ -141,8 +141,7 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
   }
   if (rollout_end_s_ > 0 && m.version > version_) {
     // How long the learner took to answer the last rollout: the wait after the next one adapts to it.
-    const double delay = nowSeconds() - rollout_end_s_;
-    learner_delay_s_ = learner_delay_s_ > 0 ? 0.7 * learner_delay_s_ + 0.3 * delay : delay;
+    await_budget_.observeAnswer(nowSeconds() - rollout_end_s_);
     rollout_end_s_ = 0;
   }
   pending_version_ = m.version;
@@ -201,10 +200,7 @@ void Actor::maybeHeartbeat() {
 }
 
 double Actor::awaitLimitSeconds() const {
-  if (options_.await_params_s <= 0) return 0.0;
-  // A learner whose updates take longer than the configured wait (a big batch, a loaded machine)
-  // would otherwise get stale rollouts it must drop: wait 1.5x its recent answer time, bounded.
-  return std::max(options_.await_params_s, std::min(options_.await_params_max_s, 1.5 * learner_delay_s_));
+  return await_budget_.limitSeconds();
 }
 
 void Actor::awaitNewerParams() {

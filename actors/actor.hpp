@@ -20,6 +20,7 @@
 #include "common/config/run_config.hpp"
 #include "common/model/actor_critic.hpp"
 #include "common/task/registry.hpp"
+#include "actors/await_budget.hpp"
 #include "common/transport/actor_rollout.hpp"
 #include "common/transport/rollout_chunker.hpp"
 #include "common/transport/transport.hpp"
@@ -149,7 +150,8 @@ class Actor {
   bool pending_has_norm_ = false;
   double rollout_end_s_ = 0;    // when the last rollout was published (0: answered already)
   double last_learner_s_ = 0;   // when the learner was last heard (new parameters or its repeat)
-  double learner_delay_s_ = 0;  // moving average of the learner's answer time to a rollout
+  // The wait for newer parameters, adapted to the learner's answer time (options_ is declared above).
+  AwaitBudget await_budget_{options_.await_params_s, options_.await_params_max_s};
   // Nothing of a rejected message is kept but these counts: it cannot change what comes after it.
   int64_t params_rejected_ = 0;
   int64_t rejects_since_warning_ = 0;
