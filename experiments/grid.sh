@@ -35,7 +35,7 @@ while [ $# -gt 0 ]; do
     --set) sets+=("$2"); shift 2 ;;
     --no-recipe) recipe=0; shift ;;
     --replot) replot=1; shift ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
