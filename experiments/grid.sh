@@ -75,6 +75,13 @@ else
   } > "$out/grid.txt"
 fi
 out=$(cd "$out" && pwd)
+# One grid per directory: a second one (a command given twice) would start the same runs afresh
+# over the first's. The lock is held until this script exits.
+exec {grid_lock}> "$out/.grid.lock"
+if ! flock -n "$grid_lock"; then
+  echo "grid.sh: another grid is running in $out (wait for it, or stop it first)" >&2
+  exit 3
+fi
 
 if [ "$replot" = 0 ]; then
   # The queue: one line per run, seeds outermost. Workers take lines under a lock.

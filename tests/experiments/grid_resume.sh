@@ -9,7 +9,7 @@ src=$(cd "$(dirname "$0")/../.." && pwd)
 export MASA_BUILD_DIR=$build OMP_NUM_THREADS=1
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
 fail() { echo "FAIL: $*"; for f in grid/a1_beam/*.log grid*.out; do [ -f "$f" ] && { echo "--- $f"; tail -n 20 "$f"; }; done; exit 1; }
-grid=("$src/experiments/grid.sh" --tasks a1_beam --methods "masa sa" --seeds 0 --updates 60 --jobs 1 --no-recipe
+grid=("$src/experiments/grid.sh" --tasks a1_beam --methods "masa sa" --seeds 0 --updates 150 --jobs 1 --no-recipe
       --out grid --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.num_envs=8
       --set ppo.horizon=8 --set ppo.minibatch_size=64 --set env.max_episode_steps=40
       --set runner.checkpoint_every=5 --set runner.eval_every=5 --set runner.eval_episodes=1)
@@ -23,22 +23,25 @@ for _ in $(seq 600); do
   sleep 0.1
 done
 [ -f "$csv" ] && [ "$(wc -l < "$csv")" -ge 12 ] || fail "masa's run wrote no 11 updates in 60 s"
+# The same grid started twice: the second is refused while the first runs (it would redo its runs).
+"${grid[@]}" > grid_twice.out 2>&1 && fail "a second grid on the same directory was accepted"
+grep -q "another grid is running in" grid_twice.out || fail "the second grid did not say why: $(cat grid_twice.out)"
 kill -TERM "$pid"
 wait "$pid" && fail "the killed grid exited 0" || true
 [ -f grid/a1_beam/masa_s0/done ] && fail "the killed run is marked done"
 [ -f grid/a1_beam/masa_s0/checkpoint.bin ] || fail "the killed run left no checkpoint"
 rows_at_kill=$(($(wc -l < "$csv") - 1))
-[ "$rows_at_kill" -lt 60 ] || fail "masa's run finished before the kill (make the runs longer)"
-echo "killed at $rows_at_kill of 60 updates"
+[ "$rows_at_kill" -lt 150 ] || fail "masa's run finished before the kill (make the runs longer)"
+echo "killed at $rows_at_kill of 150 updates"
 
 # 2. The same command again: masa goes on from its checkpoint, sa runs, the comparison is drawn.
 "${grid[@]}" > grid2.out 2>&1 || fail "the resumed grid failed"
 grep -q "0 already done" grid2.out || fail "the resumed grid thought a run was done"
 grep -q -- "--resume .*masa_s0" grid/a1_beam/masa_s0.log || fail "masa's run was not resumed from its checkpoint"
 [ -f grid/a1_beam/masa_s0/done ] && [ -f grid/a1_beam/sa_s0/done ] || fail "a run is not marked done"
-[ "$(($(wc -l < "$csv") - 1))" -eq 60 ] || fail "masa's metrics.csv has $(($(wc -l < "$csv") - 1)) rows, not 60"
-# One row per update, no update twice: the epochs are 0..59 in order.
-awk -F, 'NR > 1 && $1 != NR - 2 { bad = 1 } END { exit bad }' "$csv" || fail "masa's epochs are not 0..59 in order"
+[ "$(($(wc -l < "$csv") - 1))" -eq 150 ] || fail "masa's metrics.csv has $(($(wc -l < "$csv") - 1)) rows, not 150"
+# One row per update, no update twice: the epochs are 0..149 in order.
+awk -F, 'NR > 1 && $1 != NR - 2 { bad = 1 } END { exit bad }' "$csv" || fail "masa's epochs are not 0..149 in order"
 for f in grid/verdict.md grid/a1_beam/runs.csv grid/a1_beam/curves/return_masa.dat grid/a1_beam/curves/eval_return_sa.dat; do
   [ -s "$f" ] || fail "no $f"
 done
@@ -76,4 +79,4 @@ grep -q "2 at a time" grid6.out || fail "the hosts file's 2 slots were not used"
 [ "$(grep -c '^ssh far-host .*masa_train' remote.log)" -eq 2 ] || fail "the runs did not go through ssh to far-host"
 grep -q "^rsync -a far-host:$PWD/remote/a1_beam/masa_s0/ $PWD/remote/a1_beam/masa_s0/" remote.log || \
   fail "masa's run directory was not copied back"
-echo "PASS: killed at update $rows_at_kill, resumed to 60, finished runs not redone, comparison drawn, hosts file used"
+echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, hosts file used"
