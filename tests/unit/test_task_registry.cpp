@@ -21,7 +21,9 @@ TEST(TaskRegistry, EveryTaskFolderIsInTheListAndTheListIsWhatTheRegistryKnows) {
     EXPECT_NE(std::find(known.begin(), known.end(), f), known.end()) << "tasks/" << f << " is not in tasks/tasks.cpp";
   for (const TaskInfo& info : taskList()) {
     EXPECT_NE(std::find(known.begin(), known.end(), info.name), known.end()) << info.name;
-    if (!info.model_file.empty()) EXPECT_EQ(info.model_file, "tasks/" + info.name + "/model.xml");
+    if (!info.model_file.empty()) {
+      EXPECT_EQ(info.model_file, "tasks/" + info.name + "/model.xml");
+    }
   }
 }
 
