@@ -23,6 +23,8 @@ packages=(
   libglfw3-dev xvfb xauth ffmpeg libpng-dev
   # the run directory's learning_curve.png
   gnuplot-nox
+  # offline datasets exported to HDF5 (and h5py, to check the export as a Python user reads it)
+  libhdf5-dev python3-h5py
 )
 
 # --bench: also the packages that only the comparison benchmarks need (never CI, never a training
