@@ -159,7 +159,6 @@ int buildFamilies(const std::string& run_arg, const std::string& out_arg, int ep
   }
   fs::create_directories(out_arg);
   const fs::path out = fs::absolute(out_arg);
-  const std::string expert_name = relativeName(expert, run.parent_path() / run.filename()) ;
   auto progress = [](const char* family, const std::string& name, const Recording& r) {
     std::printf("  %-12s %-44s %5lld episodes %8lld steps  return %9.3f  %5.1f s\n", family, name.c_str(),
                 static_cast<long long>(r.episodes), static_cast<long long>(r.transitions), r.summary.ret.mean, r.seconds);
@@ -170,8 +169,8 @@ int buildFamilies(const std::string& run_arg, const std::string& out_arg, int ep
   // expert: the final policy.
   {
     dataset::DatasetLogWriter w((out / "expert.lcmlog").string());
-    progress("expert", "policy.bin", recordPolicy(expert, run.filename().string() + "/policy.bin", episodes, seed, mean,
-                                                   threads, w, nullptr));
+    const std::string name = run.filename().string() + "/policy.bin";
+    progress("expert", name, recordPolicy(expert, name, episodes, seed, mean, threads, w, nullptr));
   }
   const dataset::TransitionDataset expert_data = dataset::readDatasetLogs({(out / "expert.lcmlog").string()});
   const auto expert_episodes = dataset::datasetEpisodes(expert_data);
