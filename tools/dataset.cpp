@@ -136,6 +136,12 @@ std::vector<std::pair<int, std::string>> snapshotsOf(const fs::path& run) {
   return out;
 }
 
+bool sameBytes(const std::string& a, const std::string& b) {
+  std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+  return std::equal(std::istreambuf_iterator<char>(fa), std::istreambuf_iterator<char>(),
+                    std::istreambuf_iterator<char>(fb), std::istreambuf_iterator<char>());
+}
+
 std::string relativeName(const fs::path& file, const fs::path& run) {
   return (run.filename() / fs::relative(file, run)).string();
 }
@@ -197,7 +203,8 @@ int buildFamilies(const std::string& run_arg, const std::string& out_arg, int ep
   {
     dataset::DatasetLogWriter w((out / "mixed.lcmlog").string());
     std::vector<std::string> stages;
-    for (const auto& s : snapshots) stages.push_back(s.second);
+    for (const auto& s : snapshots)
+      if (!sameBytes(s.second, expert)) stages.push_back(s.second);  // the last stage is often the final policy
     stages.push_back(expert);
     const int n = static_cast<int>(stages.size());
     for (int i = 0; i < n; ++i) {
