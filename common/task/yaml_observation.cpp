@@ -131,7 +131,7 @@ bool signsMatch(const std::vector<int>& a, const std::vector<int>& b) {
 
 }  // namespace
 
-YamlObservation::YamlObservation(const YamlTaskConfig& config, const Task& task) {
+YamlObservation::YamlObservation(const YamlTaskConfig& config, const Task& task, const std::vector<double>& pose) {
   const sym::SymmetrySpec& spec = task.spec();
   for (const bool limb : {false, true}) {
     const auto& entries = limb ? spec.observationLayout().limb : spec.observationLayout().central;
@@ -153,17 +153,17 @@ YamlObservation::YamlObservation(const YamlTaskConfig& config, const Task& task)
                               std::to_string(e.size()) + " values of kind " + sym::entryKindName(e.kind) +
                               "); say where it comes from");
       if (!limb) {
-        resolve(*it, e, -1, e.offset, task);
+        resolve(*it, e, -1, e.offset, task, pose);
       } else {
         for (int k = 0; k < spec.numAgents(); ++k)
-          resolve(*it, e, k, spec.obsCentralDim() + k * spec.obsLimbDim() + e.offset, task);
+          resolve(*it, e, k, spec.obsCentralDim() + k * spec.obsLimbDim() + e.offset, task, pose);
       }
     }
   }
 }
 
 void YamlObservation::resolve(const ObservationSourceConfig& c, const sym::Entry& e, int limb, int out,
-                              const Task& task) {
+                              const Task& task, const std::vector<double>& pose) {
   const sym::SymmetrySpec& spec = task.spec();
   const sym::Group& g = spec.group();
   const MujocoModel& model = task.mujocoModel();
@@ -244,6 +244,8 @@ void YamlObservation::resolve(const ObservationSourceConfig& c, const sym::Entry
           throw ConfigError(c.file, c.path, "action " + spec.actNames()[a] + " drives no hinge or slide joint");
         item.qadr.push_back(m->jnt_qposadr[j]);
         item.dofadr.push_back(m->jnt_dofadr[j]);
+        // The pose is checked symmetric (yaml_task.cpp), so the offset keeps the joint's kind.
+        item.joint_offset.push_back(c.from_pose ? pose[a] : 0.0);
       }
       break;
     }
@@ -251,6 +253,14 @@ void YamlObservation::resolve(const ObservationSourceConfig& c, const sym::Entry
     case ObsSource::kBodyLinVel:
     case ObsSource::kHeading:
       if (c.source == ObsSource::kBodyPos) item.body = findNamed(model, mjOBJ_BODY, name, c.file, c.path + ".body");
+      if (!c.above_geom.empty()) {
+        item.height_offset = worldGeomTop(model, c.above_geom, c.file, c.path + ".above_geom");
+        // A constant offset stays linear only on a component the group leaves alone.
+        for (int i = 0; i < g.order; ++i)
+          if (std::abs(sym::spatialMap(g, i)(2, 2) - 1.0) > kSameAction)
+            throw ConfigError(c.file, c.path + ".above_geom",
+                              "a height above a geom is not kept by " + groupName(g) + ": the group moves z");
+      }
       if (c.source == ObsSource::kBodyLinVel) item.free = findFreeBody(model, spec, name, c.file, c.path + ".body");
       geometric([&](int i, std::string& why) { return restrict(sym::spatialMap(g, i), c.components, why); }, n_comp);
       break;
@@ -337,7 +347,7 @@ void YamlObservation::write(const mjData* d, const std::vector<double>& last_act
     float* o = out + it.out;
     switch (it.source) {
       case ObsSource::kJointPos:
-        for (std::size_t k = 0; k < it.qadr.size(); ++k) o[k] = static_cast<float>(d->qpos[it.qadr[k]]);
+        for (std::size_t k = 0; k < it.qadr.size(); ++k) o[k] = static_cast<float>(d->qpos[it.qadr[k]] - it.joint_offset[k]);
         break;
       case ObsSource::kJointVel:
         for (std::size_t k = 0; k < it.dofadr.size(); ++k) o[k] = static_cast<float>(d->qvel[it.dofadr[k]]);
@@ -345,7 +355,12 @@ void YamlObservation::write(const mjData* d, const std::vector<double>& last_act
       case ObsSource::kLastAction:
         for (std::size_t k = 0; k < it.actions.size(); ++k) o[k] = static_cast<float>(last_action[it.actions[k]]);
         break;
-      case ObsSource::kBodyPos: putComponents(Eigen::Vector3d(d->xpos + 3 * it.body), it.components, o); break;
+      case ObsSource::kBodyPos: {
+        Eigen::Vector3d p(d->xpos + 3 * it.body);
+        p.z() -= it.height_offset;
+        putComponents(p, it.components, o);
+        break;
+      }
       case ObsSource::kBodyLinVel: putComponents(it.free.linearVelocity(d), it.components, o); break;
       case ObsSource::kBodyAngVel:
         putComponents(it.body_frame ? it.free.angularVelocityBody(d) : it.free.angularVelocityWorld(d), it.components, o);

@@ -13,7 +13,7 @@
 
 #include <Eigen/Core>
 
-#include "common/task/free_body.hpp"
+#include "common/task/model_lookup.hpp"
 #include "common/task/task.hpp"
 #include "common/task/yaml_task_config.hpp"
 
@@ -21,8 +21,9 @@ namespace masa::task {
 
 class YamlObservation {
  public:
-  // `task` gives the model, the spec and which joint each action drives.
-  YamlObservation(const YamlTaskConfig& config, const Task& task);
+  // `task` gives the model, the spec and which joint each action drives; `pose` is the reference
+  // position of each action's joint (what `from_pose` observes from).
+  YamlObservation(const YamlTaskConfig& config, const Task& task, const std::vector<double>& pose);
 
   // obsDim() values from the current state: poses must be fresh (mj_kinematics), and sensors too
   // when usesSensors() (mj_forward).
@@ -36,7 +37,9 @@ class YamlObservation {
     int out = 0;                // first output index
     std::vector<int> actions;   // joint sources: the action indices, in the entry's order
     std::vector<int> qadr, dofadr;
+    std::vector<double> joint_offset;  // joint_pos: subtracted (the pose, or 0)
     int body = -1;              // body_pos
+    double height_offset = 0.0;  // body_pos z: subtracted (a geom's top, or 0)
     FreeBody free;              // free-body sources
     int sensor_adr = 0, sensor_dim = 0;
     std::vector<int> components;
@@ -44,7 +47,8 @@ class YamlObservation {
     bool body_frame = false;
   };
 
-  void resolve(const ObservationSourceConfig& c, const sym::Entry& e, int limb, int out, const Task& task);
+  void resolve(const ObservationSourceConfig& c, const sym::Entry& e, int limb, int out, const Task& task,
+               const std::vector<double>& pose);
 
   std::vector<Item> items_;
   bool uses_sensors_ = false;

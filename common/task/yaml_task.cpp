@@ -1,7 +1,8 @@
 // "yaml": a task described by its config instead of code (docs/yaml_task.md). The observation
 // comes from named joints, bodies and sensors (yaml_observation.hpp); the reward is a sum of
 // locomotion and balance terms (forward velocity towards a heading, alive, upright, heading,
-// lateral velocity, action and energy costs); the episode ends on a body's height or tilt. The
+// lateral velocity, action and energy costs); the episode ends on a body's height or tilt; actions
+// drive the actuators through their ctrlrange or a PD loop around the pose (yaml_pose.hpp). The
 // heading is task state: the symmetry rotates it with the robot, so a walk towards it stays
 // symmetric under any group, and a policy can observe it (source: heading).
 #include <algorithm>
@@ -11,8 +12,9 @@
 
 #include "common/core/config_error.hpp"
 #include "common/symmetry/group_element.hpp"
-#include "common/task/free_body.hpp"
+#include "common/task/model_lookup.hpp"
 #include "common/task/yaml_observation.hpp"
+#include "common/task/yaml_pose.hpp"
 #include "common/task/yaml_task_config.hpp"
 #include "tasks/tasks.hpp"
 
@@ -69,19 +71,31 @@ class YamlTask final : public Task {
   }
 
  protected:
-  // The reference pose (reset.joint_pos, else the model's qpos0) plus uniform noise on each actuated
-  // joint, kept inside its range; uniform noise on every velocity; then the heading.
+  // The pose plus uniform noise on each actuated joint's position (kept inside its range) and
+  // velocity, noise on every velocity, the robot stood on its support, then the heading. A noise
+  // of 0 draws nothing.
   void resetTask(Rng& rng) override {
     const mjModel* m = model();
+    const ResetConfig& r = config_.reset;
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     for (int k = 0; k < actDim(); ++k) {
       const int j = jointOfAction(k);
+      targets_[k] = pose_[k];
       if (j < 0) continue;
-      double q = reset_pose_[k] + config_.reset.joint_noise * unit(rng);
+      double q = pose_[k];
+      if (r.joint_noise > 0) q += r.joint_noise * unit(rng);
       if (m->jnt_limited[j]) q = std::clamp(q, m->jnt_range[2 * j], m->jnt_range[2 * j + 1]);
       data_->qpos[m->jnt_qposadr[j]] = q;
+      if (r.joint_velocity_noise > 0) data_->qvel[m->jnt_dofadr[j]] = r.joint_velocity_noise * unit(rng);
     }
-    for (int d = 0; d < m->nv; ++d) data_->qvel[d] = config_.reset.velocity_noise * unit(rng);
+    if (r.velocity_noise > 0)
+      for (int d = 0; d < m->nv; ++d) data_->qvel[d] = r.velocity_noise * unit(rng);
+    if (!feet_.empty()) {
+      mj_kinematics(m, data_);
+      double lowest = 1e9;
+      for (int g : feet_) lowest = std::min(lowest, data_->geom_xpos[3 * g + 2] - m->geom_rbound[g]);
+      data_->qpos[rest_base_qadr_ + 2] += support_top_ + r.clearance - lowest;
+    }
     heading_ = config_.heading.direction;
     if (config_.heading.random_yaw) {
       const double yaw = std::numbers::pi * unit(rng);
@@ -90,6 +104,38 @@ class YamlTask final : public Task {
     if (walker_ >= 0) start_ = Eigen::Vector3d(data_->qpos + rewards_[walker_].free.qadr);
   }
 
+  void applyAction(const double* action) override {
+    if (!config_.actuation.pd) return Task::applyAction(action);
+    for (int k = 0; k < actDim(); ++k) targets_[k] = pose_[k] + config_.actuation.action_scale * action[k];
+  }
+
+  // The PD loop runs every physics substep.
+  void beforeSubstep() override {
+    if (!config_.actuation.pd) return;
+    const mjModel* m = model();
+    for (int k = 0; k < actDim(); ++k) {
+      const int j = jointOfAction(k);
+      const double tau = config_.actuation.kp * (targets_[k] - data_->qpos[m->jnt_qposadr[j]]) -
+                         config_.actuation.kd * data_->qvel[m->jnt_dofadr[j]];
+      data_->ctrl[actuatorOfAction(k)] = std::clamp(tau, -torque_limit_[k], torque_limit_[k]);
+    }
+  }
+
+ public:
+  // The PD law as a robot's joint command (masa_deploy); a task driving torques has none.
+  bool jointCommand(const double* action, double* position, double* velocity, double* torque_ff, double* kp,
+                    double* kd) const override {
+    if (!config_.actuation.pd) return false;
+    for (int k = 0; k < actDim(); ++k) {
+      position[k] = pose_[k] + config_.actuation.action_scale * std::clamp(action[k], -1.0, 1.0);
+      velocity[k] = torque_ff[k] = 0.0;
+      kp[k] = config_.actuation.kp;
+      kd[k] = config_.actuation.kd;
+    }
+    return true;
+  }
+
+ protected:
   void writeObservation(float* out) const override { observation_.write(data_, lastAction(), heading_, out); }
 
   // MuJoCo computes sensors inside mj_step, before its last substep: refresh them for the final state.
@@ -132,7 +178,7 @@ class YamlTask final : public Task {
       const TerminationConfig& c = config_.termination[k];
       const End& e = ends_[k];
       if (c.type == TerminationType::kHeight) {
-        const double below = e.above < 0 ? 0.0 : data_->xpos[3 * e.above + 2];
+        const double below = e.above >= 0 ? data_->xpos[3 * e.above + 2] : e.above_top;
         if (data_->xpos[3 * e.body + 2] - below < c.min) return true;
       } else if (bodyAxis(data_, e.body, c.axis).z() < c.min) {
         return true;
@@ -158,13 +204,15 @@ class YamlTask final : public Task {
     FreeBody free;
   };
   struct End {
-    int body = -1, above = -1;
+    int body = -1, above = -1;  // above: a body, else the constant height above_top
+    double above_top = 0.0;
   };
 
   YamlTask(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec, EnvParams& p, YamlTaskConfig c)
       : Task("yaml", std::move(model), spec, p, termsWithUnitWeights(c)),
         config_(std::move(c)),
-        observation_(config_, *this) {
+        pose_(resolvePose(config_, *this)),
+        observation_(config_, *this, pose_) {
     const MujocoModel& mm = mujocoModel();
     for (const RewardTermConfig& t : config_.reward) {
       Term term;
@@ -180,10 +228,12 @@ class YamlTask final : public Task {
       End e;
       e.body = findNamed(mm, mjOBJ_BODY, t.body, t.file, t.path + ".body");
       if (!t.above.empty()) e.above = findNamed(mm, mjOBJ_BODY, t.above, t.file, t.path + ".above");
+      if (!t.above_geom.empty()) e.above_top = worldGeomTop(mm, t.above_geom, t.file, t.path + ".above_geom");
       if (t.type == TerminationType::kUpright) checkAxisMeasure(t.body, t.axis, false, t.file, t.path);
       ends_.push_back(e);
     }
-    resolveResetPose();
+    resolveActuation();
+    resolveRestOn();
   }
 
   // Bodies moved by a listed free joint are checked here; others (links of a limb) by masa_verify.
@@ -199,46 +249,46 @@ class YamlTask final : public Task {
     }
   }
 
-  // reset.joint_pos names action entries (a limb entry sets that joint in every limb) or joints.
-  void resolveResetPose() {
+  // A PD loop needs a joint per action and a symmetric ctrlrange: its torque limit.
+  void resolveActuation() {
+    targets_ = pose_;
+    torque_limit_.assign(actDim(), 0.0);
+    if (!config_.actuation.pd) return;
     const mjModel* m = model();
-    reset_pose_.assign(actDim(), 0.0);
-    for (int k = 0; k < actDim(); ++k)
-      if (jointOfAction(k) >= 0) reset_pose_[k] = m->qpos0[m->jnt_qposadr[jointOfAction(k)]];
-    const sym::SymmetrySpec& s = spec();
-    for (const ResetJointConfig& r : config_.reset.joint_pos) {
-      bool found = false;
-      auto setEntry = [&](const std::vector<sym::Entry>& block, int first_action) {
-        for (const sym::Entry& e : block)
-          if (e.name == r.name) {
-            for (int c = 0; c < e.size(); ++c) reset_pose_[first_action + e.offset + c] = r.value;
-            found = true;
-          }
-      };
-      setEntry(s.actionLayout().central, 0);
-      for (int limb = 0; limb < s.numAgents(); ++limb)
-        setEntry(s.actionLayout().limb, s.actCentralDim() + limb * s.actLimbDim());
-      if (found) continue;
-      const int j = mj_name2id(m, mjOBJ_JOINT, r.name.c_str());
-      const auto& joints = actionJoints();
-      const auto at = std::find(joints.begin(), joints.end(), j);
-      if (j < 0 || at == joints.end()) {
-        std::string known;
-        for (const auto* block : {&s.actionLayout().central, &s.actionLayout().limb})
-          for (const sym::Entry& e : *block) known += (known.empty() ? "" : ", ") + e.name;
-        throw ConfigError(r.file, r.path,
-                          "'" + r.name + "' is neither an action entry of " + s.source() + " (" + known +
-                              ") nor an actuated joint of " + mujocoModel().path());
-      }
-      reset_pose_[at - joints.begin()] = r.value;
+    for (int k = 0; k < actDim(); ++k) {
+      const int a = actuatorOfAction(k);
+      const double* range = m->actuator_ctrlrange + 2 * a;
+      if (jointOfAction(k) < 0 || !m->actuator_ctrllimited[a] || range[0] != -range[1])
+        throw ConfigError(config_.actuation.file, "env.actuation",
+                          "a PD loop drives each action's joint through an actuator with a symmetric ctrlrange (its "
+                          "torque limit); action " + spec().actNames()[k] + "'s does not have one");
+      torque_limit_[k] = range[1];
     }
   }
 
+  void resolveRestOn() {
+    const ResetConfig& r = config_.reset;
+    if (r.support.empty()) return;
+    const std::string at = r.path + ".rest_on";
+    support_top_ = worldGeomTop(mujocoModel(), r.support, r.file, at + ".support");
+    for (const std::string& f : r.feet) feet_.push_back(findNamed(mujocoModel(), mjOBJ_GEOM, f, r.file, at + ".feet"));
+    if (!hasRobotBase())
+      throw ConfigError(r.file, at, "standing the robot on a support moves its base: the spec's mujoco.free_joints "
+                                    "lists no robot_base");
+    for (const auto& fj : spec().mujoco().free_joints)
+      if (fj.kind == sym::FreeJointKind::kRobotBase)
+        rest_base_qadr_ = model()->jnt_qposadr[mj_name2id(model(), mjOBJ_JOINT, fj.name.c_str())];
+  }
+
   YamlTaskConfig config_;
+  std::vector<double> pose_;  // per action: its joint's reference position
   YamlObservation observation_;
   std::vector<Term> rewards_;
   std::vector<End> ends_;
-  std::vector<double> reset_pose_;  // per action: its joint's reference position
+  std::vector<double> targets_, torque_limit_;  // PD loop, per action
+  std::vector<int> feet_;                       // reset.rest_on: geoms
+  double support_top_ = 0.0;
+  int rest_base_qadr_ = -1;
   int walker_ = -1;                 // the first forward_velocity term: its body's walk is the progress
   Eigen::Vector3d heading_{1.0, 0.0, 0.0}, start_{0.0, 0.0, 0.0};
 };

@@ -52,6 +52,15 @@ T lookupType(const YAML::Node& n, const std::string& key, const std::map<std::st
   return it->second;
 }
 
+bool flag(const YamlFields& f, const std::string& key, bool fallback) {
+  if (!f.has(key)) return fallback;
+  try {
+    return f.node(key).as<bool>();
+  } catch (const YAML::Exception&) {
+    f.fail(key, "expected true or false");
+  }
+}
+
 int axisIndex(const YamlFields& f, const std::string& key, int fallback) {
   if (!f.has(key)) return fallback;
   const std::string a = f.text(key);
@@ -111,10 +120,10 @@ ObservationSourceConfig readSource(const YAML::Node& n, const std::string& entry
   c.source = lookupType(n, "source", kSources, path, file);
   std::vector<std::string> keys = {"source"};
   switch (c.source) {
-    case ObsSource::kJointPos:
+    case ObsSource::kJointPos: keys.insert(keys.end(), {"action", "joint", "from_pose"}); break;
     case ObsSource::kJointVel:
     case ObsSource::kLastAction: keys.insert(keys.end(), {"action", "joint"}); break;
-    case ObsSource::kBodyPos:
+    case ObsSource::kBodyPos: keys.insert(keys.end(), {"body", "components", "above_geom"}); break;
     case ObsSource::kBodyLinVel: keys.insert(keys.end(), {"body", "components"}); break;
     case ObsSource::kBodyAngVel: keys.insert(keys.end(), {"body", "components", "frame"}); break;
     case ObsSource::kBodyQuatW:
@@ -145,6 +154,10 @@ ObservationSourceConfig readSource(const YAML::Node& n, const std::string& entry
   const std::string frame = f.text("frame", "world");
   if (frame != "world" && frame != "body") f.fail("frame", "expected world or body, got '" + frame + "'");
   c.body_frame = frame == "body";
+  c.from_pose = flag(f, "from_pose", false);
+  c.above_geom = f.text("above_geom", "");
+  if (!c.above_geom.empty() && c.components != std::vector<int>{2})
+    f.fail("above_geom", "a height above a geom is the z component alone: add components: z");
   return c;
 }
 
@@ -162,18 +175,28 @@ std::vector<ObservationSourceConfig> readBlock(EnvParams& p, const YAML::Node& b
   return out;
 }
 
+// Calls read(name, node, key path, file) for each entry of the mapping env.<section> (name -> {type, ...}).
+template <class Read>
+void forEachNamed(EnvParams& p, const std::string& section, Read read) {
+  const YAML::Node n = p.section(section);
+  if (!n.IsDefined() || n.IsNull()) return;
+  if (!n.IsMap()) failAt(p.origin(section), "env." + section, n, "expected a mapping: name -> {type, ...}");
+  for (const auto& kv : n) {
+    const std::string name = kv.first.Scalar();
+    read(name, kv.second, "env." + section + "." + name, p.origin(section + "." + name));
+  }
+}
+
 std::vector<RewardTermConfig> readReward(EnvParams& p) {
   std::vector<RewardTermConfig> out;
-  const YAML::Node n = p.section("reward");
-  if (!n.IsDefined() || n.IsNull()) return out;
-  if (!n.IsMap()) failAt(p.origin("reward"), "env.reward", n, "expected a mapping: term name -> {type, ...}");
-  for (const auto& kv : n) {
+  forEachNamed(p, "reward", [&](const std::string& name, const YAML::Node& n, const std::string& path,
+                                const std::string& file) {
     RewardTermConfig t;
-    t.name = kv.first.Scalar();
-    t.path = "env.reward." + t.name;
-    t.file = p.origin("reward." + t.name);
-    if (t.name == "termination") failAt(t.file, t.path, kv.first, "'termination' is the name of the termination reward");
-    t.type = lookupType(kv.second, "type", kRewards, t.path, t.file);
+    t.name = name;
+    t.path = path;
+    t.file = file;
+    if (name == "termination") failAt(file, path, n, "'termination' is the name of the termination reward");
+    t.type = lookupType(n, "type", kRewards, path, file);
     std::vector<std::string> keys = {"type"};
     switch (t.type) {
       case RewardType::kForwardVelocity: keys.insert(keys.end(), {"body", "target"}); break;
@@ -182,7 +205,7 @@ std::vector<RewardTermConfig> readReward(EnvParams& p) {
       case RewardType::kLateralVelocity: keys.push_back("body"); break;
       default: break;
     }
-    const YamlFields f(kv.second, t.path, t.file, keys);
+    const YamlFields f(n, path, file, keys);
     if (keys.size() > 1) t.body = f.text("body");
     t.axis = axisIndex(f, "axis", t.type == RewardType::kUpright ? 2 : 0);
     t.has_target = f.has("target");
@@ -190,53 +213,92 @@ std::vector<RewardTermConfig> readReward(EnvParams& p) {
     t.has_threshold = f.has("min");
     t.threshold = f.number("min", 0.0);
     out.push_back(t);
-  }
+  });
   return out;
 }
 
 std::vector<TerminationConfig> readTermination(EnvParams& p) {
   std::vector<TerminationConfig> out;
-  const YAML::Node n = p.section("termination");
-  if (!n.IsDefined() || n.IsNull()) return out;
-  if (!n.IsMap()) failAt(p.origin("termination"), "env.termination", n, "expected a mapping: name -> {type, ...}");
-  for (const auto& kv : n) {
+  forEachNamed(p, "termination", [&](const std::string& name, const YAML::Node& n, const std::string& path,
+                                     const std::string& file) {
     TerminationConfig t;
-    t.name = kv.first.Scalar();
-    t.path = "env.termination." + t.name;
-    t.file = p.origin("termination." + t.name);
-    t.type = lookupType(kv.second, "type", kTerminations, t.path, t.file);
-    const YamlFields f(kv.second, t.path, t.file,
-                       t.type == TerminationType::kHeight ? std::vector<std::string>{"type", "body", "above", "min"}
-                                                          : std::vector<std::string>{"type", "body", "axis", "min"});
+    t.name = name;
+    t.path = path;
+    t.file = file;
+    t.type = lookupType(n, "type", kTerminations, path, file);
+    const YamlFields f(n, path, file,
+                       t.type == TerminationType::kHeight
+                           ? std::vector<std::string>{"type", "body", "above", "above_geom", "min"}
+                           : std::vector<std::string>{"type", "body", "axis", "min"});
     t.body = f.text("body");
     t.above = f.text("above", "");
+    t.above_geom = f.text("above_geom", "");
+    if (!t.above.empty() && !t.above_geom.empty()) f.fail("above_geom", "give either above (a body) or above_geom");
     t.axis = axisIndex(f, "axis", 2);
     t.min = f.number("min");
     out.push_back(t);
+  });
+  return out;
+}
+
+std::vector<PoseJointConfig> readPose(EnvParams& p) {
+  std::vector<PoseJointConfig> out;
+  const YAML::Node n = p.section("pose");
+  if (!n.IsDefined() || n.IsNull()) return out;
+  const std::string file = p.origin("pose");
+  if (!n.IsMap()) failAt(file, "env.pose", n, "expected a mapping: action entry or joint name -> position");
+  for (const auto& kv : n) {
+    PoseJointConfig j{kv.first.Scalar(), "env.pose." + kv.first.Scalar(), file, 0.0};
+    try {
+      j.value = kv.second.as<double>();
+    } catch (const YAML::Exception&) {
+      failAt(file, j.path, kv.second, "expected a number (rad, or m for a slide joint)");
+    }
+    out.push_back(j);
   }
   return out;
+}
+
+ActuationConfig readActuation(EnvParams& p) {
+  ActuationConfig a;
+  const YAML::Node n = p.section("actuation");
+  a.file = p.origin("actuation");
+  if (!n.IsDefined() || n.IsNull()) return a;
+  const std::string type = n.IsMap() && n["type"] ? n["type"].as<std::string>() : "";
+  const bool pd = type == "pd";
+  const YamlFields f(n, "env.actuation", p.origin("actuation"),
+                     pd ? std::vector<std::string>{"type", "kp", "kd", "action_scale"} : std::vector<std::string>{"type"});
+  if (type != "pd" && type != "ctrlrange") f.fail("type", "expected ctrlrange (the default) or pd, got '" + type + "'");
+  a.pd = pd;
+  if (!pd) return a;
+  a.kp = f.number("kp");
+  a.kd = f.number("kd");
+  a.action_scale = f.number("action_scale");
+  if (!(a.kp > 0)) f.fail("kp", "must be positive");
+  if (a.kd < 0) f.fail("kd", "must be >= 0");
+  if (!(a.action_scale > 0)) f.fail("action_scale", "must be positive");
+  return a;
 }
 
 ResetConfig readReset(EnvParams& p) {
   ResetConfig r;
   const YAML::Node n = p.section("reset");
+  r.path = "env.reset";
+  r.file = p.origin("reset");
   if (!n.IsDefined() || n.IsNull()) return r;
-  const YamlFields f(n, "env.reset", p.origin("reset"), {"joint_pos", "joint_noise", "velocity_noise"});
+  const YamlFields f(n, r.path, r.file, {"joint_noise", "joint_velocity_noise", "velocity_noise", "rest_on"});
+  for (const char* key : {"joint_noise", "joint_velocity_noise", "velocity_noise"})
+    if (f.number(key, 0.0) < 0) f.fail(key, "must be >= 0");
   r.joint_noise = f.number("joint_noise", 0.0);
+  r.joint_velocity_noise = f.number("joint_velocity_noise", 0.0);
   r.velocity_noise = f.number("velocity_noise", 0.0);
-  if (r.joint_noise < 0) f.fail("joint_noise", "must be >= 0");
-  if (r.velocity_noise < 0) f.fail("velocity_noise", "must be >= 0");
-  if (f.has("joint_pos")) {
-    const YAML::Node jp = f.node("joint_pos");
-    if (!jp.IsMap()) f.fail("joint_pos", "expected a mapping: action entry or joint name -> position");
-    const YamlFields values(jp, f.pathOf("joint_pos"), f.file(), [&] {
-      std::vector<std::string> all;
-      for (const auto& kv : jp) all.push_back(kv.first.Scalar());
-      return all;
-    }());
-    for (const auto& kv : jp)
-      r.joint_pos.push_back({kv.first.Scalar(), values.pathOf(kv.first.Scalar()), f.file(),
-                             values.number(kv.first.Scalar())});
+  if (f.has("rest_on")) {
+    const YamlFields rest(f.node("rest_on"), f.pathOf("rest_on"), r.file, {"support", "feet", "clearance"});
+    r.support = rest.text("support");
+    const YAML::Node feet = rest.node("feet");
+    if (!feet.IsSequence() || feet.size() == 0) rest.fail("feet", "expected a list of geom names");
+    for (const auto& g : feet) r.feet.push_back(g.as<std::string>());
+    r.clearance = rest.number("clearance", 0.0);
   }
   return r;
 }
@@ -282,6 +344,8 @@ YamlTaskConfig readYamlTaskConfig(EnvParams& p, int num_limbs) {
   c.limb = readBlock(p, f.node("limb"), "limb", true, num_limbs);
   c.reward = readReward(p);
   c.termination = readTermination(p);
+  c.pose = readPose(p);
+  c.actuation = readActuation(p);
   c.reset = readReset(p);
   c.heading = readHeading(p);
   return c;

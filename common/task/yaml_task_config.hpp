@@ -1,6 +1,7 @@
 // The description of a task written in YAML (the `env` section of a task config whose
 // task_code is `yaml`, docs/yaml_task.md): where each observation entry of the spec comes from,
-// the reward terms, the terminations, the reset and the heading to walk towards. Read and checked
+// the reward terms, the terminations, the reference pose, the actuation, the reset and the heading
+// to walk towards. Read and checked
 // here for its own shape (unknown keys, wrong types, names per limb); the names are checked against
 // the model and the kinds against the spec where the task resolves them (yaml_observation.hpp).
 #pragma once
@@ -39,6 +40,8 @@ struct ObservationSourceConfig {
   std::vector<int> components{0, 1, 2};  // x, y, z of a vector source
   int axis = 2;                    // body_axis: the local axis; body_euler: 0 roll, 1 pitch, 2 yaw
   bool body_frame = false;         // body_ang_vel in the free joint's body frame
+  bool from_pose = false;          // joint_pos: the offset from the reference pose
+  std::string above_geom;          // body_pos z: the height above the top of this world geom
 };
 
 enum class RewardType { kAlive, kForwardVelocity, kHeading, kUpright, kLateralVelocity, kActionSquared, kEnergy };
@@ -60,20 +63,37 @@ struct TerminationConfig {
   std::string name, path, file;
   TerminationType type = TerminationType::kHeight;
   std::string body;
-  std::string above;  // height: measured above this body's height ("" = above z = 0)
+  std::string above;       // height: measured above this body's height ...
+  std::string above_geom;  // ... or above the top of this world geom ("" for both: above z = 0)
   int axis = 2;       // upright: the local axis whose world z is tested
   double min = 0.0;   // the episode ends when the measure drops below it
 };
 
-struct ResetJointConfig {
+struct PoseJointConfig {
   std::string name, path, file;  // an action entry (every limb's for a limb entry) or a joint
   double value = 0.0;
 };
 
+// How actions become controls: the actuators' ctrlrange, or a PD loop around the pose.
+struct ActuationConfig {
+  bool pd = false;
+  double kp = 0.0, kd = 0.0;   // N m / rad, N m s / rad; torques clamped to each actuator's ctrlrange
+  double action_scale = 0.0;   // target offset from the pose per unit action (rad)
+  std::string file;            // where it was written
+};
+
+// A noise of 0 draws nothing. Draw order: per actuated joint (action order) its position, then its
+// velocity; then every degree of freedom's velocity; then the heading.
 struct ResetConfig {
-  std::vector<ResetJointConfig> joint_pos;  // else the model's reference pose (qpos0)
-  double joint_noise = 0.0;                 // uniform +- on each actuated joint, kept inside its range
-  double velocity_noise = 0.0;              // uniform +- on every degree of freedom
+  double joint_noise = 0.0;           // uniform +- on each actuated joint's position, kept inside its range
+  double joint_velocity_noise = 0.0;  // uniform +- on each actuated joint's velocity
+  double velocity_noise = 0.0;        // uniform +- on every degree of freedom's velocity
+  // rest_on: the robot base is moved up or down so that the lowest of `feet` (geoms, their bounding
+  // sphere) stands `clearance` above the top of the world geom `support`.
+  std::string support;
+  std::vector<std::string> feet;
+  double clearance = 0.0;
+  std::string path, file;
 };
 
 struct HeadingConfig {
@@ -86,12 +106,14 @@ struct YamlTaskConfig {
   std::vector<ObservationSourceConfig> central, limb;  // in the config's order; keyed by spec entry
   std::vector<RewardTermConfig> reward;
   std::vector<TerminationConfig> termination;
+  std::vector<PoseJointConfig> pose;  // the reference pose; other joints keep the model's qpos0
+  ActuationConfig actuation;
   ResetConfig reset;
   HeadingConfig heading;
 };
 
-// Reads env.observation, env.reward, env.termination, env.reset and env.heading (each marked as
-// read in `params`). `num_limbs` expands "{limb}" name templates. Throws ConfigError naming the
+// Reads env.observation, env.reward, env.termination, env.pose, env.actuation, env.reset and
+// env.heading (each marked as read in `params`). `num_limbs` expands "{limb}" name templates. Throws ConfigError naming the
 // file and key path.
 YamlTaskConfig readYamlTaskConfig(EnvParams& params, int num_limbs);
 

@@ -200,9 +200,12 @@ TEST(YamlTask, MistakesNameTheKeyAndWhatWouldBeRight) {
       {"a heading term on an axis the rotation moves",
        [](YAML::Node& e) { e["reward"]["facing"] = YAML::Load("{type: heading, body: torso, axis: x}"); },
        {"env.reward.facing.axis", "body 'torso'", "another of its axes takes the place of its local x axis"}},
-      {"a reset pose of nothing",
-       [](YAML::Node& e) { e["reset"]["joint_pos"]["ankle"] = 1.0; },
-       {"env.reset.joint_pos.ankle", "neither an action entry", "hip, knee"}},
+      {"a pose of nothing",
+       [](YAML::Node& e) { e["pose"]["ankle"] = 1.0; },
+       {"env.pose.ankle", "neither an action entry", "hip, knee"}},
+      {"a pose the rotation does not keep",
+       [](YAML::Node& e) { e["pose"]["knee0"] = 0.3; },
+       {"env.pose", "the pose is not symmetric", "limb0.knee"}},
   };
   for (const Case& c : cases) {
     const std::string e = buildError(editedEnv(kWalker, c.edit));

@@ -1,4 +1,4 @@
-#include "common/task/free_body.hpp"
+#include "common/task/model_lookup.hpp"
 
 #include "common/core/config_error.hpp"
 
@@ -12,13 +12,38 @@ int findNamed(const MujocoModel& model, int type, const std::string& name, const
   const char* type_name = mju_type2Str(type);
   std::string known;
   int count = 0;
-  const int total = type == mjOBJ_BODY ? m->nbody : type == mjOBJ_JOINT ? m->njnt : type == mjOBJ_SENSOR ? m->nsensor
-                                                                                                         : 0;
+  const int total = type == mjOBJ_BODY     ? m->nbody
+                    : type == mjOBJ_JOINT  ? m->njnt
+                    : type == mjOBJ_SENSOR ? m->nsensor
+                    : type == mjOBJ_GEOM   ? m->ngeom
+                                           : 0;
   for (int k = 0; k < total; ++k)
     if (const char* n = mj_id2name(m, type, k); n && *n) known += (count++ ? ", " : "") + std::string(n);
   throw ConfigError(file, path,
                     model.path() + " has no " + (type_name ? type_name : "object") + " named '" + name + "'" +
                         (count ? " (it has: " + known + ")" : " (it names none)"));
+}
+
+double worldGeomTop(const MujocoModel& model, const std::string& name, const std::string& file,
+                    const std::string& path) {
+  const mjModel* m = model.get();
+  const int g = findNamed(model, mjOBJ_GEOM, name, file, path);
+  if (m->geom_bodyid[g] != 0)
+    throw ConfigError(file, path, "geom '" + name + "' must be fixed in the world (a child of worldbody)");
+  const double* q = m->geom_quat + 4 * g;
+  if (q[1] != 0.0 || q[2] != 0.0)
+    throw ConfigError(file, path, "geom '" + name + "' is tilted: its top is not one height");
+  const double* size = m->geom_size + 3 * g;
+  const double z = m->geom_pos[3 * g + 2];
+  switch (m->geom_type[g]) {
+    case mjGEOM_PLANE: return z;
+    case mjGEOM_BOX: return z + size[2];
+    case mjGEOM_SPHERE: return z + size[0];
+    case mjGEOM_CYLINDER: return z + size[1];
+    case mjGEOM_CAPSULE: return z + size[0] + size[1];
+    default: throw ConfigError(file, path, "geom '" + name + "': its top is known for a plane, box, sphere, cylinder "
+                                           "or capsule only");
+  }
 }
 
 FreeBody findFreeBody(const MujocoModel& model, const sym::SymmetrySpec& spec, const std::string& name,

@@ -17,6 +17,12 @@ namespace masa::task {
 int findNamed(const MujocoModel& model, int type, const std::string& name, const std::string& file,
               const std::string& path);
 
+// The height of the top of a geom fixed in the world (a floor, a beam), from the model: a plane's
+// z, or the centre plus the half height of an upright box, sphere, cylinder or capsule.
+// ConfigError at `file`/`path` for a geom that moves, is tilted, or has another shape.
+double worldGeomTop(const MujocoModel& model, const std::string& name, const std::string& file,
+                    const std::string& path);
+
 struct FreeBody {
   int body = -1, qadr = -1, vadr = -1;
   sym::FreeJointKind kind = sym::FreeJointKind::kObject;
