@@ -84,6 +84,22 @@ TEST(YamlTaskTwin, A1BeamInYamlMatchesItsCppTaskTermByTerm) {
   EXPECT_EQ(stiff.outcome_mismatches, 0);
 }
 
+// What masa_deploy sends a robot: the same PD command from both, and none from a torque task.
+TEST(YamlTaskTwin, A1BeamInYamlGivesTheSameJointCommand) {
+  const auto cpp = test::runConfigFactory("a1_beam").create();
+  const auto yaml = test::runConfigFactory("a1_beam_yaml").create();
+  Rng rng(4);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);  // beyond [-1, 1]: the clamp too
+  const int n = cpp->actDim();
+  std::vector<double> action(n), a(5 * n), b(5 * n);
+  for (double& x : action) x = u(rng);
+  ASSERT_TRUE(cpp->jointCommand(action.data(), &a[0], &a[n], &a[2 * n], &a[3 * n], &a[4 * n]));
+  ASSERT_TRUE(yaml->jointCommand(action.data(), &b[0], &b[n], &b[2 * n], &b[3 * n], &b[4 * n]));
+  EXPECT_EQ(a, b);
+  EXPECT_FALSE(test::runConfigFactory("ant_acrobatic_yaml").create()->jointCommand(action.data(), &b[0], &b[n],
+                                                                                   &b[2 * n], &b[3 * n], &b[4 * n]));
+}
+
 // The comparison can fail: a threshold of the YAML description moved, or its reset changed, and
 // the twins part.
 TEST(YamlTaskTwin, ADifferenceInTheDescriptionIsSeen) {
