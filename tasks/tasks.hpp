@@ -8,8 +8,11 @@
 
 namespace masa::task {
 
-// The makers, one per task folder (and the model-only "mjcf" task of common/task/mjcf_task.cpp).
+// The makers, one per task folder, and the two tasks without code of their own: "mjcf" (a model
+// alone, common/task/mjcf_task.cpp) and "yaml" (a task described by its config, common/task/yaml_task.cpp).
 std::unique_ptr<Task> makeMjcf(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec, EnvParams& params);
+std::unique_ptr<Task> makeYamlTask(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
+                                   EnvParams& params);
 std::unique_ptr<Task> makeA1Beam(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec, EnvParams& params);
 std::unique_ptr<Task> makeAntAcrobatic(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
                                        EnvParams& params);

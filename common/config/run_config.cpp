@@ -265,7 +265,12 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   }
   rc.seed = r.get<std::uint64_t>("seed", "a non-negative integer");
   rc.spec_path = r.get<std::string>("spec", "a file path");
-  if (rc.spec_path.empty()) rc.spec_path = configs_dir + "/specs/" + rc.task + ".yaml";
+  if (rc.spec_path.empty()) {
+    rc.spec_path = configs_dir + "/specs/" + rc.task + ".yaml";
+  } else if (const fs::path in_tree = fs::path(configs_dir).parent_path() / rc.spec_path;
+             fs::path(rc.spec_path).is_relative() && fs::exists(in_tree)) {
+    rc.spec_path = in_tree.string();  // a task file's spec: relative to the source tree, wherever the run starts
+  }
 
   model::ModelConfig& m = rc.model;
   m.method = rc.method;

@@ -89,6 +89,11 @@ std::string EnvParams::text(const std::string& key, const std::string& fallback)
 
 double EnvParams::weight(const std::string& term, double fallback) { return number("weights." + term, fallback); }
 
+YAML::Node EnvParams::section(const std::string& key) {
+  asked_.insert(key);
+  return lookup(key);
+}
+
 void EnvParams::finish() const {
   // Walk every leaf key of env and check it was asked for.
   std::vector<std::pair<std::string, YAML::Node>> stack{{"", env_}};
@@ -98,9 +103,10 @@ void EnvParams::finish() const {
     if (!node.IsMap()) continue;
     for (const auto& kv : node) {
       const std::string key = prefix.empty() ? kv.first.as<std::string>() : prefix + "." + kv.first.as<std::string>();
+      if (asked_.count(key)) continue;  // a leaf, or a section its reader validated
       if (kv.second.IsMap()) {
         stack.emplace_back(key, kv.second);
-      } else if (!asked_.count(key)) {
+      } else {
         std::string known;
         for (const auto& a : asked_) known += (known.empty() ? "" : ", ") + a;
         throw ConfigError(originOf(key), "env." + key, "unknown task parameter (known: " + known + ")");

@@ -24,6 +24,10 @@ class EnvParams {
   std::string text(const std::string& key, const std::string& fallback);
   // The reward weight of `term`, from env.weights.<term>.
   double weight(const std::string& term, double fallback);
+  // A whole sub-tree (a list or mapping), undefined when absent; the caller validates what is inside
+  // (finish() no longer looks into it). origin() names the file that set a key, for its errors.
+  YAML::Node section(const std::string& key);
+  std::string origin(const std::string& key) const { return originOf(key); }
 
   void finish() const;  // throws ConfigError for keys never asked for
 

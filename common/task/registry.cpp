@@ -43,14 +43,17 @@ std::vector<std::string> registeredTasks() {
 TaskFactory::TaskFactory(const std::string& name, const sym::SymmetrySpec& spec, const YAML::Node& env,
                          const std::map<std::string, std::string>& origin, const std::string& default_origin)
     : name_(name), spec_(spec), env_(YAML::Clone(env)), origin_(origin), default_origin_(default_origin) {
-  const auto it = table().find(name);
+  EnvParams probe(env_, origin_, default_origin_);
+  const std::string code = probe.text("task_code", name);
+  const auto it = table().find(code);
   if (it == table().end()) {
     std::string known;
     for (const auto& n : registeredTasks()) known += (known.empty() ? "" : ", ") + n;
-    throw std::runtime_error("unknown task '" + name + "' (known: " + known + ")");
+    const std::string what = "unknown task '" + code + "' (known: " + known + ")";
+    if (code != name) throw ConfigError(probe.origin("task_code"), "env.task_code", what);
+    throw std::runtime_error(what + "; a task described in YAML sets env.task_code: yaml");
   }
   make_ = it->second.make;
-  EnvParams probe(env_, origin_, default_origin_);
   std::string file = probe.text("model_file", it->second.model_file);
   if (file.empty()) throw ConfigError(default_origin_, "env.model_file", "task '" + name + "' needs a model file");
   if (!file.empty() && file[0] != '/') file = sourceRoot() + "/" + file;
@@ -63,6 +66,7 @@ TaskFactory::TaskFactory(const std::string& name, const sym::SymmetrySpec& spec,
 std::unique_ptr<Task> TaskFactory::create() const {
   EnvParams params(env_, origin_, default_origin_);
   params.text("model_file", "");
+  params.text("task_code", "");
   return make_(model_, spec_, params);
 }
 

@@ -28,7 +28,9 @@ std::vector<std::string> registeredTasks();
 class TaskFactory {
  public:
   // Loads the model (env.model_file overrides the registered path) and validates the env section
-  // by building one task; throws std::runtime_error or ConfigError naming what is wrong.
+  // by building one task; throws std::runtime_error or ConfigError naming what is wrong. The code
+  // that runs is the listed task called env.task_code when given, else `name`: a config of its
+  // own name can run another task's code, e.g. `task_code: yaml` for a task written in YAML.
   TaskFactory(const std::string& name, const sym::SymmetrySpec& spec, const YAML::Node& env,
               const std::map<std::string, std::string>& origin = {}, const std::string& default_origin = "configs");
 

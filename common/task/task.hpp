@@ -114,6 +114,7 @@ class Task {
   int jointOfAction(int k) const { return action_joint_[k]; }
 
   const mjModel* model() const { return model_->get(); }
+  const MujocoModel& mujocoModel() const { return *model_; }  // with its file path and named lookups
   const mjData* data() const { return data_; }
   mjData* data() { return data_; }
   const std::vector<double>& lastAction() const { return last_action_; }  // clamped, action order
