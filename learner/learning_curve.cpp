@@ -91,6 +91,12 @@ LearningCurve::LearningCurve(std::string run_dir, std::string title, std::vector
   writeScript(term_names, title);
 }
 
+LearningCurve::LearningCurve(std::string run_dir, const Script& script) : dir_(std::move(run_dir)) {
+  script_ = (fs::path(dir_) / "learning_curve.gp").string();
+  png_ = (fs::path(dir_) / "learning_curve.png").string();
+  std::ofstream(script_) << script.text;
+}
+
 LearningCurve::~LearningCurve() { reap(true); }
 
 void LearningCurve::writeScript(const std::vector<std::string>& term_names, const std::string& title) const {

@@ -16,6 +16,11 @@ class LearningCurve {
  public:
   // term_names: the task's reward terms, as the metrics.csv columns term_<name>.
   LearningCurve(std::string run_dir, std::string title, std::vector<std::string> term_names);
+  // A run whose metrics.csv has other columns (masa_offline's): its own script, rendered the same way.
+  struct Script {
+    std::string text;
+  };
+  LearningCurve(std::string run_dir, const Script& script);
   ~LearningCurve();  // waits for a render in flight
   LearningCurve(const LearningCurve&) = delete;
   LearningCurve& operator=(const LearningCurve&) = delete;
