@@ -9,8 +9,9 @@
 // squared value error; their gradients are elementwise and counted as free. FLOPs count the
 // products exactly: 2*in*out per layer forward, 4*in*out backward less the first layer's dx.
 //
-// Counters: GFLOPs (GFLOP/s over the timed steps), and of_peak = that over the machine's fp32 FMA
-// peak for the threads used (../shared/PERFORMANCE.md: about 223 GFLOP/s on one core, 408 on two).
+// Counters: GFLOPs (GFLOP/s over the timed steps), and of_peak = that over this machine's fp32 FMA
+// peak for the threads used, measured at start-up (machine_peak.hpp; the CPU model and the peaks
+// are in the benchmark's context lines).
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -21,6 +22,7 @@
 
 #include "common/nn/adam.hpp"
 #include "common/nn/mlp.hpp"
+#include "machine_peak.hpp"
 
 namespace {
 
@@ -45,10 +47,9 @@ double flopsPerSample(const MlpShape& s) {
   return f - 2.0 * w[0] * w[1];  // no input gradient for the first layer
 }
 
-double peakGflops(int threads) {
-  // PERFORMANCE.md's measured fp32 FMA peaks; more threads than cores do not add any.
-  return threads >= 2 ? 408.0 : 223.0;
-}
+const bool kMachineDescribed = masa::bench::describeMachine();
+
+double peakGflops(int threads) { return masa::bench::measuredPeakGflops(threads); }
 
 // Policy, and optionally critic, with their batch, targets and optimizer.
 struct Learner {

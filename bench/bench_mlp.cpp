@@ -7,6 +7,7 @@
 
 #include "common/nn/adam.hpp"
 #include "common/nn/mlp.hpp"
+#include "machine_peak.hpp"
 
 namespace {
 
@@ -35,11 +36,13 @@ double forwardFlopsPerSample(const MlpShape& s) {
   return f;
 }
 
+const bool kMachineDescribed = masa::bench::describeMachine();
+
+// GFLOP/s; this machine's measured peak is in the context lines (fp32_fma_peak_gflops_*).
 void report(benchmark::State& state, int batch, double flops_per_sample) {
   state.SetItemsProcessed(state.iterations() * batch);
-  state.counters["GFLOP/s"] =
-      benchmark::Counter(flops_per_sample * batch * static_cast<double>(state.iterations()) * 1e-9,
-                         benchmark::Counter::kIsRate);
+  const double gflop = flops_per_sample * batch * static_cast<double>(state.iterations()) * 1e-9;
+  state.counters["GFLOP/s"] = benchmark::Counter(gflop, benchmark::Counter::kIsRate);
 }
 
 void BM_TrainStep(benchmark::State& state) {

@@ -42,7 +42,7 @@ done
 [ -n "$out" ] && out=$(abs "$out")
 [ -n "$hosts" ] && hosts=$(abs "$hosts")
 build=${MASA_BUILD_DIR:-build}
-[ -x "$build/tools/masa_train" ] || { echo "grid.sh: $build/tools/masa_train is missing: run deploy/build.sh first" >&2; exit 2; }
+[ -x "$build/tools/masa_train" ] || { echo "grid.sh: $build/tools/masa_train is missing: run scripts/build.sh first" >&2; exit 2; }
 
 # The grid's definition is kept in DIR/grid.txt: a rerun with --out DIR and no grid options
 # continues it, and a rerun that names a different grid for the same DIR is refused.

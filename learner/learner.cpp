@@ -289,6 +289,17 @@ void Learner::update(const transport::RolloutBatch& batch) {
     std::fflush(stdout);
   }
   if (rc_.runner.checkpoint_every > 0 && epoch_ % rc_.runner.checkpoint_every == 0) writeCheckpoint();
+  if (rc_.runner.snapshot_every > 0 && epoch_ % rc_.runner.snapshot_every == 0) writeSnapshot();
+}
+
+void Learner::writeSnapshot() {
+  // The policy of this stage, kept: offline datasets of many training stages ("mixed") are
+  // recorded from them (masa_dataset families).
+  const fs::path dir = fs::path(dir_) / "policies";
+  fs::create_directories(dir);
+  char name[32];
+  std::snprintf(name, sizeof name, "policy_u%06lld.bin", static_cast<long long>(epoch_));
+  policy::savePolicyFile((dir / name).string(), rc_, *model_);
 }
 
 void Learner::publishParams() {

@@ -72,6 +72,7 @@ class Learner {
   void run(int64_t max_updates, const std::atomic<bool>* stop);
 
   void writeCheckpoint();
+  void writeSnapshot();
   void publishParams();
   // The total number of updates planned, for the progress line's ETA (run() sets it too).
   void setMaxUpdates(int64_t max_updates) { max_updates_ = max_updates; }

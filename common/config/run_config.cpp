@@ -318,6 +318,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   u.eval_every = r.atLeast("runner.eval_every", 0);
   u.eval_episodes = r.atLeast("runner.eval_episodes", 1);
   u.silence_warn_s = r.nonNegative("runner.silence_warn_s");
+  u.snapshot_every = r.atLeast("runner.snapshot_every", 0);
 
   rc.env = YAML::Clone(merged["env"]);
   rc.resolved = merged;

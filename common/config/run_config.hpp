@@ -48,6 +48,7 @@ struct RunnerConfig {
   int eval_every = 50;             // updates between evaluations of the policy mean (0: never)
   int eval_episodes = 8;           // episodes per evaluation
   double silence_warn_s = 30.0;    // seconds without rollout data before the learner says so (0: never)
+  int snapshot_every = 0;          // updates between kept policies/policy_uNNNNNN.bin (0: none)
 };
 
 struct RunConfig {

@@ -31,7 +31,7 @@ Moments moments(const std::vector<double>& x) {
 PolicyEvaluator::PolicyEvaluator(const TaskFactory& factory, model::ActorCritic<float>& model)
     : factory_(&factory), model_(&model) {}
 
-EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook) {
+EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook, const TransitionHook& transitions) {
   MASA_CHECK(o.episodes > 0, "evaluation needs at least one episode, got " << o.episodes);
   const int n = o.episodes;
   std::vector<std::unique_ptr<Task>> envs(n);
@@ -60,6 +60,7 @@ EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook) {
   for (int k = 0; k < n; ++k) active[k] = k;
   Mat<float> obs(obs_dim, n), act(act_dim, n);
   std::vector<char> done(n, 0);
+  std::vector<StepOutcome> outcomes(n);
   for (int t = 0; t < limit && !active.empty(); ++t) {
     const int m = static_cast<int>(active.size());
     for (int j = 0; j < m; ++j) envs[active[j]]->observe(obs.col(j).data());
@@ -72,10 +73,18 @@ EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook) {
 #pragma omp parallel for num_threads(std::max(1, std::min(o.threads, m))) schedule(static)
     for (int j = 0; j < m; ++j) {
       const StepOutcome out = envs[active[j]]->step(act.col(j).data());
+      outcomes[active[j]] = out;
       done[active[j]] = out.terminated || out.truncated || t + 1 == limit;
     }
     if (hook)
       for (int j = 0; j < m; ++j) hook(active[j], t, *envs[active[j]], done[active[j]] != 0);
+    if (transitions)
+      for (int j = 0; j < m; ++j) {
+        const int k = active[j];
+        StepOutcome out = outcomes[k];
+        out.truncated = done[k] && !out.terminated;  // max_steps cuts like the time limit
+        transitions({k, t, obs.col(j).data(), act.col(j).data(), out, done[k] != 0}, *envs[k]);
+      }
     std::vector<int> still;
     still.reserve(m);
     for (int k : active) {

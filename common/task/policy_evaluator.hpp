@@ -50,9 +50,20 @@ class PolicyEvaluator {
   // Called after every step t of episode k (for video), the task in its post-step state; `last`
   // on the episode's final step.
   using StepHook = std::function<void(int k, int t, const Task& task, bool last)>;
+  // Called after every step t of episode k with what a dataset records: the observation the
+  // action was chosen from, the action taken, and the step's outcome; the task is in its
+  // post-step state (its observe() gives the next observation). Called in episode order.
+  struct Transition {
+    int k = 0, t = 0;
+    const float* obs = nullptr;
+    const float* action = nullptr;
+    StepOutcome outcome;
+    bool last = false;
+  };
+  using TransitionHook = std::function<void(const Transition& tr, const Task& task)>;
 
   PolicyEvaluator(const TaskFactory& factory, model::ActorCritic<float>& model);
-  EvalSummary run(const EvalOptions& options, const StepHook& hook = {});
+  EvalSummary run(const EvalOptions& options, const StepHook& hook = {}, const TransitionHook& transitions = {});
 
  private:
   const TaskFactory* factory_;

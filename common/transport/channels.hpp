@@ -11,5 +11,7 @@ inline constexpr const char* kHeartbeatChannel = "MASA_ACTOR_HEARTBEAT";   // lc
 // A robot and its policy runner (masa_deploy, masa_sim_robot); the deploy config may rename them.
 inline constexpr const char* kRobotStateChannel = "MASA_ROBOT_STATE";      // lcmt_robot_state
 inline constexpr const char* kRobotCommandChannel = "MASA_ROBOT_COMMAND";  // lcmt_robot_command
+// Offline datasets: recorded episodes (masa_dataset record).
+inline constexpr const char* kDatasetChannel = "MASA_DATASET";            // lcmt_transitions
 
 }  // namespace masa::transport

@@ -19,6 +19,7 @@ class lcmt_learner_stats;
 class lcmt_actor_heartbeat;
 class lcmt_robot_state;
 class lcmt_robot_command;
+class lcmt_transitions;
 }  // namespace masa
 
 namespace masa::transport {
@@ -162,6 +163,30 @@ struct WireLayoutOf<masa::lcmt_robot_command> {
       {"torque_ff", WireType::kDouble, "num_joints"},
       {"kp", WireType::kDouble, "num_joints"},
       {"kd", WireType::kDouble, "num_joints"},
+  };
+};
+
+template <>
+struct WireLayoutOf<masa::lcmt_transitions> {
+  static constexpr WireField fields[] = {
+      {"utime", WireType::kInt64},
+      {"task", WireType::kString},
+      {"episode_id", WireType::kInt64},
+      {"policy_id", WireType::kInt32},
+      {"policy_name", WireType::kString},
+      {"step_offset", WireType::kInt32},
+      {"num_steps", WireType::kInt32},
+      {"obs_dim", WireType::kInt32},
+      {"act_dim", WireType::kInt32},
+      {"obs_len", WireType::kInt32},
+      {"obs", WireType::kFloat, "obs_len"},
+      {"actions_len", WireType::kInt32},
+      {"actions", WireType::kFloat, "actions_len"},
+      {"rewards", WireType::kFloat, "num_steps"},
+      {"last", WireType::kBoolean},
+      {"terminated", WireType::kBoolean},
+      {"truncated", WireType::kBoolean},
+      {"success", WireType::kInt8},
   };
 };
 

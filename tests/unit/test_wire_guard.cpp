@@ -15,6 +15,7 @@
 #include "masa/lcmt_learner_stats.hpp"
 #include "masa/lcmt_policy_params.hpp"
 #include "masa/lcmt_robot_command.hpp"
+#include "masa/lcmt_transitions.hpp"
 #include "masa/lcmt_robot_state.hpp"
 #include "masa/lcmt_rollout_chunk.hpp"
 #include "test_transport_support.hpp"
@@ -75,6 +76,7 @@ TEST(WireGuard, EveryLayoutTableMatchesLcmGensTypeHash) {
   EXPECT_EQ(lcmHashOfTable<masa::lcmt_rollout_chunk>(), masa::lcmt_rollout_chunk::getHash());
   EXPECT_EQ(lcmHashOfTable<masa::lcmt_robot_state>(), masa::lcmt_robot_state::getHash());
   EXPECT_EQ(lcmHashOfTable<masa::lcmt_robot_command>(), masa::lcmt_robot_command::getHash());
+  EXPECT_EQ(lcmHashOfTable<masa::lcmt_transitions>(), masa::lcmt_transitions::getHash());
 }
 
 TEST(WireGuard, ATableWhoseLengthNamesNoEarlierIntegerFieldIsRefused) {
