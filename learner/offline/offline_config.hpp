@@ -26,7 +26,7 @@ struct OfflineConfig {
   double polyak = 0.005;
   std::vector<int> q_hidden{256, 256};
   double log_std_min = -5.0, log_std_max = 2.0;
-  bool normalize_reward = true;
+  bool normalize_reward = false;
   int log_every = 1000;
   long long eval_every = 50000;
   int eval_episodes = 10;

@@ -62,6 +62,7 @@ struct OfflineRun::Impl {
   std::vector<std::string> progress_names;
   std::ofstream csv;
   std::unique_ptr<learner::LearningCurve> curve;
+  double reward_scale = 1.0;  // IQL's TD target multiplies rewards by it
 
   Impl(const config::RunConfig& config, dataset::TransitionDataset d, OfflineRunOptions o)
       : rc(config),
@@ -84,8 +85,8 @@ struct OfflineRun::Impl {
       q_target = std::make_unique<TwinQ<float>>(spec, rc.method, oc.q_hidden, rc.model.activation);
       q->initialize(rng);
       q_target->moveTowards(*q, 1.0f);
-      iql = std::make_unique<IqlTrainer<float>>(model, *q, *q_target, oc,
-                                                oc.normalize_reward ? rewardScaleForReturns(data) : 1.0);
+      reward_scale = oc.normalize_reward ? rewardScaleForReturns(data) : 1.0;
+      iql = std::make_unique<IqlTrainer<float>>(model, *q, *q_target, oc, reward_scale);
       losses = {"value_loss", "actor_loss", "q_loss"};
       figures = {"mean_q", "mean_v", "mean_advantage", "mean_weight"};
     }
@@ -181,11 +182,13 @@ OfflineRun::~OfflineRun() = default;
 
 task::EvalSummary OfflineRun::run() {
   Impl& m = *impl_;
-  if (m.opt.verbose)
+  if (m.opt.verbose) {
     std::printf("%s offline: %s / %s on %lld transitions (%zu episodes), %lld steps of batch %d -> %s\n",
                 m.rc.task.c_str(), algoName(m.oc.algo).c_str(),
                 m.oc.augment ? "sasa-data" : model::methodName(m.rc.method).c_str(), static_cast<long long>(m.data.size()),
                 m.data.episodes.size(), m.oc.steps, m.oc.batch_size, m.opt.run_dir.c_str());
+    if (m.iql) std::printf("  rewards x %.4g in the TD target (offline.normalize_reward)\n", m.reward_scale);
+  }
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   auto row_start = t0;
