@@ -2,6 +2,7 @@
 #pragma once
 
 #include "common/dataset/transition_dataset.hpp"
+#include "common/model/actor_critic.hpp"
 #include "learner/offline/offline_config.hpp"
 #include "model_test_support.hpp"
 
@@ -37,6 +38,18 @@ inline dataset::TransitionDataset randomDataset(const sym::SymmetrySpec& spec, i
   }
   d.validate();
   return d;
+}
+
+// A model with small networks for tests. last_layer_scale 1 gives O(1) outputs from the start
+// (gradient and symmetry checks); the default keeps the small initial actions of training.
+inline model::ModelConfig smallOfflineModel(model::Method method, std::vector<int> policy_hidden,
+                                            std::vector<int> critic_hidden, double last_layer_scale = 0.01) {
+  model::ModelConfig m;
+  m.method = method;
+  m.policy_hidden = std::move(policy_hidden);
+  m.critic_hidden = std::move(critic_hidden);
+  m.policy_last_layer_scale = last_layer_scale;
+  return m;
 }
 
 // The offline defaults with small numbers for tests.

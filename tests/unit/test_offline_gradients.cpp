@@ -11,12 +11,8 @@
 namespace masa::offline {
 namespace {
 
-model::ModelConfig smallModel(model::Method method) {
-  model::ModelConfig m;
-  m.method = method;
-  m.policy_hidden = {9, 6};
-  m.critic_hidden = {8, 5};
-  m.policy_last_layer_scale = 1.0;
+model::ModelConfig gradientModel(model::Method method) {
+  model::ModelConfig m = test::smallOfflineModel(method, {9, 6}, {8, 5}, 1.0);
   m.init_log_std = -0.2;
   return m;
 }
@@ -29,7 +25,7 @@ struct Fixture {
 
   Fixture(const char* yaml, model::Method method)
       : spec(test::spec(yaml, "spec")),
-        model(spec, smallModel(method)),
+        model(spec, gradientModel(method)),
         q(spec, method, {7, 5}, nn::Activation::kElu),
         q_target(spec, method, {7, 5}, nn::Activation::kElu) {
     Rng rng(11);

@@ -16,14 +16,6 @@
 namespace masa::offline {
 namespace {
 
-model::ModelConfig smallModel(model::Method method, std::vector<int> hidden) {
-  model::ModelConfig m;
-  m.method = method;
-  m.policy_hidden = hidden;
-  m.critic_hidden = hidden;
-  return m;
-}
-
 // ---- BC: a = K o + noise with an equivariant K (so that MASA can represent it too).
 
 Eigen::MatrixXd equivariantLinearPolicy(const sym::SymmetrySpec& spec, Rng& rng) {
@@ -59,7 +51,7 @@ TEST(OfflineLearning, BcRecoversAKnownLinearPolicyAndItsNoise) {
     const Eigen::MatrixXd k = equivariantLinearPolicy(spec, rng);
     const double noise = 0.1;
     const auto data = linearPolicyData(k, noise, 20000, rng);
-    model::ActorCritic<float> m(spec, smallModel(method, {64}));
+    model::ActorCritic<float> m(spec, test::smallOfflineModel(method, {64}, {64}));
     m.initialize(rng);
     fitObservationNormalizer(m, data);
     auto cfg = test::smallOfflineConfig(Algo::kBc, 2000);
@@ -183,7 +175,7 @@ double trainedPointReturn(const sym::SymmetrySpec& spec, const dataset::Transiti
                           Algo algo, int steps) {
   const int w = 32;
   Rng rng(42);
-  model::ActorCritic<float> m(spec, smallModel(method, {w, w}));
+  model::ActorCritic<float> m(spec, test::smallOfflineModel(method, {w, w}, {w, w}));
   m.initialize(rng);
   fitObservationNormalizer(m, data);
   auto cfg = test::smallOfflineConfig(algo, steps);
