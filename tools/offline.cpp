@@ -2,7 +2,9 @@
 // SASA-data (SA on the dataset augmented with its symmetric images) or MASA.
 //   masa_offline --dataset data/a1_expert.lcm --algo iql --method masa --steps 100000 --out runs/a1_iql_masa
 //   masa_offline --dataset a.lcm b.lcm --algo bc --method sasa-data --seed 3 --set offline.bc_loss=mse
-// The task is the dataset's. Networks default to IQL's (256, 256) for policy, V and Q (--set
+// The task is the dataset's; its env section (reward weights, episode length) is the task file's
+// unless --env-of names the policy that recorded the data (evaluate where it was recorded) or
+// --recipe the recipe it was trained with. Networks default to IQL's (256, 256) for policy, V and Q (--set
 // model.policy_hidden=[...] to change); every other number is configs/defaults.yaml's `offline`
 // section. The run directory gets config.yaml, metrics.csv, learning_curve.png, policy.bin (for
 // masa_eval --policy and the robot runner) and eval.txt (the final evaluation, 100 episodes).
@@ -10,10 +12,12 @@
 #include <omp.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "common/core/config_error.hpp"
 #include "common/dataset/dataset_log.hpp"
+#include "common/policy/policy_file.hpp"
 #include "learner/offline/offline_run.hpp"
 
 using namespace masa;
@@ -28,12 +32,25 @@ std::vector<std::string> methodSettings(const std::string& method) {
   throw std::runtime_error("unknown method '" + method + "' (offline methods: sa, sasa-data, masa)");
 }
 
+// "env=<the policy file's env section>" as one override (YAML flow style on one line).
+std::string envOf(const std::string& target) {
+  namespace fs = std::filesystem;
+  fs::path p = target;
+  if (fs::is_directory(p)) p /= "policy.bin";
+  const policy::LoadedPolicy lp = policy::loadPolicyFile(p.string());
+  YAML::Emitter out;
+  out.SetMapFormat(YAML::Flow);
+  out.SetSeqFormat(YAML::Flow);
+  out << lp.config.env;
+  return std::string("env=") + out.c_str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"masa offline: BC or IQL on recorded datasets, as SA, SASA-data or MASA"};
   std::vector<std::string> logs, overrides;
-  std::string algo = "iql", method = "masa", run_dir, configs = config::defaultConfigsDir();
+  std::string algo = "iql", method = "masa", run_dir, configs = config::defaultConfigsDir(), recipe, env_of;
   long long steps = 0;
   long long seed = -1;
   int threads = 1;
@@ -44,6 +61,8 @@ int main(int argc, char** argv) {
   app.add_option("--steps", steps, "gradient steps (default: offline.steps)")->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "seed of initialization and sampling (default: the config's)")->check(CLI::NonNegativeNumber);
   app.add_option("--out", run_dir, "run directory (default runs/<task>_offline_<algo>_<method>_<seed>)");
+  app.add_option("--env-of", env_of, "policy file or run directory whose env section to use (the recording policy's)");
+  app.add_option("--recipe", recipe, "a recipe of configs/recipes/ (or a YAML file), applied before --set");
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set offline.beta=10");
   app.add_option("--configs", configs, "configs directory")->capture_default_str();
   app.add_option("--threads", threads, "OpenMP threads of the networks and of the evaluation episodes")->capture_default_str()
@@ -61,9 +80,11 @@ int main(int argc, char** argv) {
     dataset::TransitionDataset data = dataset::readDatasetLogs(logs, &report);
     if (!quiet) std::printf("%s", report.summary().c_str());
     if (data.task.empty()) throw std::runtime_error("the dataset names no task: cannot tell which simulator to evaluate in");
-    // Defaults < offline network sizes < the dataset's task < --set < the explicit flags.
+    // Defaults < offline network sizes < the dataset's task < recipe < recording env < --set < flags.
     std::vector<std::string> all = {"model.policy_hidden=[256, 256]", "model.critic_hidden=[256, 256]",
                                     "task=" + data.task};
+    if (!recipe.empty()) all.push_back("@" + recipe);
+    if (!env_of.empty()) all.push_back(envOf(env_of));
     all.insert(all.end(), overrides.begin(), overrides.end());
     all.insert(all.end(), settings.begin(), settings.end());
     all.push_back("offline.algo=" + algo);

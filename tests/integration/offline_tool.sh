@@ -33,6 +33,12 @@ done
 grep -q "augment: true" "$work/bc_sasa-data/config.yaml" || fail "the SASA-data run's config does not say augment"
 grep -q "equivariance checked on load" "$work/eval_iql.log" || fail "masa_eval did not check the MASA IQL policy's symmetry"
 
+# --env-of: the recording policy's env section (the shipped A1 policy's reward weights), --set still on top.
+"$tool" "${tiny[@]}" --algo bc --method masa --env-of tasks/a1_beam/policy/policy.bin --set offline.final_eval_episodes=0 \
+  --out "$work/env_of" > "$work/env_of.log" 2>&1 || fail "--env-of failed: $(cat "$work/env_of.log")"
+grep -q "action: -0.05" "$work/env_of/config.yaml" && grep -q "max_episode_steps: 40" "$work/env_of/config.yaml" ||
+  fail "--env-of did not take the policy's env under --set: $(grep -A3 '^env' "$work/env_of/config.yaml")"
+
 refused() {  # refused <what the error must say> <args...>
   local want=$1; shift
   if "$tool" "$@" > "$work/err.log" 2>&1; then fail "accepted: $*"; fi
@@ -42,4 +48,4 @@ refused "unknown method 'ma'" "${tiny[@]}" --method ma
 refused "unknown algorithm 'cql'" "${tiny[@]}" --algo cql
 refused "recorded in task 'a1_beam'" "${tiny[@]}" --set task=trifinger_lift
 refused "no/such.lcmlog" --dataset no/such.lcmlog
-echo "PASS: BC (sasa-data) and IQL (masa) trained on a recorded log, masa_eval loads both; bad input refused"
+echo "PASS: BC (sasa-data) and IQL (masa) trained on a recorded log, masa_eval loads both; --env-of takes the recording env; bad input refused"
