@@ -18,37 +18,49 @@ namespace masa::learner {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-// gnuplot strings are double-quoted: keep a title from breaking out of them.
-std::string quoted(const std::string& s) {
+std::string gnuplotQuoted(const std::string& s) {
   std::string out;
   for (char c : s)
     if (c != '"' && c != '\\' && c != '\n') out += c;
   return '"' + out + '"';
 }
 
-}  // namespace
-
-std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names) {
+std::string curveScriptHeader(const std::string& what, const std::string& writer, const std::string& title,
+                              const std::string& xlabel) {
   std::ostringstream g;
-  std::string terms;
-  for (const auto& t : term_names) terms += (terms.empty() ? "" : " ") + t;
-  g << "# Learning curves of a masa run, drawn from metrics.csv (written by masa_learner).\n"
+  g << "# Learning curves of " << what << ", drawn from metrics.csv (written by " << writer
+    << ").\n"
        "# Re-render inside the run directory with: gnuplot learning_curve.gp\n"
        "set datafile separator \",\"\n"
        "set terminal pngcairo size 1500,900 font \",10\"\n"
        "set output \"learning_curve.png.tmp\"\n"
        "set termoption noenhanced  # task and term names have underscores, not subscripts\n"
        "set multiplot layout 2,3 title "
-    << quoted(title)
+    << gnuplotQuoted(title)
     << "\n"
        "set grid\n"
        "set key top left\n"
-       "set xlabel \"env steps\"\n"
+       "set xlabel "
+    << gnuplotQuoted(xlabel)
+    << "\n"
        "set style data linespoints\n"
-       "set pointsize 0.4\n"
-       "# Updates in which no episode ended have no return: the CSV says nan there.\n"
+       "set pointsize 0.4\n";
+  return g.str();
+}
+
+std::string curveScriptFooter() {
+  return "unset multiplot\n"
+         "set output\n"
+         "# Renamed only when complete, so a viewer never sees half a picture.\n"
+         "system(\"mv -f learning_curve.png.tmp learning_curve.png\")\n";
+}
+
+std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names) {
+  std::ostringstream g;
+  std::string terms;
+  for (const auto& t : term_names) terms += (terms.empty() ? "" : " ") + t;
+  g << curveScriptHeader("a masa run", "masa_learner", title, "env steps")
+    << "# Updates in which no episode ended have no return: the CSV says nan there.\n"
        "set title \"mean episode return\"\n"
        "plot \"metrics.csv\" using \"env_steps\":\"return\" pt 7 lw 2 title \"return (training)\", \\\n"
        "     \"\" using \"env_steps\":\"eval_return\" with points pt 5 ps 0.9 title \"return (policy mean)\"\n"
@@ -65,7 +77,7 @@ std::string learningCurveScript(const std::string& title, const std::vector<std:
   if (term_names.empty())
     g << "plot \"metrics.csv\" using \"env_steps\":\"return\" pt 7 title \"return\"\n";
   else
-    g << "plot for [t in " << quoted(terms) << "] \"metrics.csv\" using \"env_steps\":(column(\"term_\".t)) pt 7 title t\n";
+    g << "plot for [t in " << gnuplotQuoted(terms) << "] \"metrics.csv\" using \"env_steps\":(column(\"term_\".t)) pt 7 title t\n";
   g << "set key top left font \",10\"\n"
        "set title \"losses\"\n"
        "plot \"metrics.csv\" using \"env_steps\":\"actor_loss\" pt 7 title \"actor\", \\\n"
@@ -77,10 +89,7 @@ std::string learningCurveScript(const std::string& title, const std::vector<std:
        "unset logscale y\n"
        "set title \"throughput\"\n"
        "plot \"metrics.csv\" using \"env_steps\":\"fps\" pt 7 title \"env steps / s\"\n"
-       "unset multiplot\n"
-       "set output\n"
-       "# Renamed only when complete, so a viewer never sees half a picture.\n"
-       "system(\"mv -f learning_curve.png.tmp learning_curve.png\")\n";
+    << curveScriptFooter();
   return g.str();
 }
 
@@ -89,6 +98,12 @@ LearningCurve::LearningCurve(std::string run_dir, std::string title, std::vector
   script_ = (fs::path(dir_) / "learning_curve.gp").string();
   png_ = (fs::path(dir_) / "learning_curve.png").string();
   writeScript(term_names, title);
+}
+
+LearningCurve::LearningCurve(std::string run_dir, const Script& script) : dir_(std::move(run_dir)) {
+  script_ = (fs::path(dir_) / "learning_curve.gp").string();
+  png_ = (fs::path(dir_) / "learning_curve.png").string();
+  std::ofstream(script_) << script.text;
 }
 
 LearningCurve::~LearningCurve() { reap(true); }

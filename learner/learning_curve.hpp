@@ -16,6 +16,11 @@ class LearningCurve {
  public:
   // term_names: the task's reward terms, as the metrics.csv columns term_<name>.
   LearningCurve(std::string run_dir, std::string title, std::vector<std::string> term_names);
+  // A run whose metrics.csv has other columns (masa_offline's): its own script, rendered the same way.
+  struct Script {
+    std::string text;
+  };
+  LearningCurve(std::string run_dir, const Script& script);
   ~LearningCurve();  // waits for a render in flight
   LearningCurve(const LearningCurve&) = delete;
   LearningCurve& operator=(const LearningCurve&) = delete;
@@ -38,6 +43,16 @@ class LearningCurve {
   int last_status_ = 0;
   bool gnuplot_missing_ = false;
 };
+
+// What every run's curve script shares: the 2 x 3 PNG page titled `title` with `xlabel` under each
+// panel (header; `what` and `writer` name the run and the program in its comment), and the rename
+// that publishes the picture whole (footer).
+std::string curveScriptHeader(const std::string& what, const std::string& writer, const std::string& title,
+                              const std::string& xlabel);
+std::string curveScriptFooter();
+// A gnuplot double-quoted string: quotes, backslashes and newlines dropped, so that a title cannot
+// break out of it.
+std::string gnuplotQuoted(const std::string& s);
 
 // gnuplot script text for a metrics.csv with these reward terms (exposed for tests).
 std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names);

@@ -30,15 +30,22 @@ void readPod(std::istream& is, T& v, const char* what) {
 }  // namespace
 
 template <typename S>
-Adam<S>::Adam(ParameterSet<S>& params, AdamConfig<S> config) : params_(&params), config_(config) {
+Adam<S>::Adam(ParameterSet<S>& params, AdamConfig<S> config) : Adam(params, config, 0, params.size()) {}
+
+template <typename S>
+Adam<S>::Adam(ParameterSet<S>& params, AdamConfig<S> config, int begin, int end)
+    : params_(&params), config_(config), begin_(begin), end_(end) {
   MASA_CHECK(params.finalized(), "Adam needs a finalized parameter set");
-  m_ = Vec<S>::Zero(params.size());
-  v_ = Vec<S>::Zero(params.size());
+  MASA_CHECK(0 <= begin && begin <= end && end <= params.size(),
+             "Adam range [" << begin << ", " << end << ") outside the parameter set's " << params.size() << " values");
+  m_ = Vec<S>::Zero(end - begin);
+  v_ = Vec<S>::Zero(end - begin);
 }
 
 template <typename S>
 void Adam<S>::step() {
-  MASA_CHECK(params_->size() == m_.size(), "Adam: parameter set has " << params_->size() << " values, state has " << m_.size());
+  MASA_CHECK(params_->size() >= end_ && end_ - begin_ == m_.size(),
+             "Adam: parameter set has " << params_->size() << " values, state covers [" << begin_ << ", " << end_ << ")");
   MASA_CHECK(config_.lr >= S(0) && config_.eps > S(0), "Adam: lr " << config_.lr << ", eps " << config_.eps);
   ++t_;
   const S b1 = config_.beta1, b2 = config_.beta2;
@@ -53,12 +60,12 @@ void Adam<S>::step() {
   const Eigen::Index n = m_.size();
   for (Eigen::Index i = 0; i < n; i += kBlock) {
     const Eigen::Index len = std::min(kBlock, n - i);
-    auto g = params_->grads().segment(i, len).array();
+    auto g = params_->grads().segment(begin_ + i, len).array();
     auto m = m_.segment(i, len).array();
     auto v = v_.segment(i, len).array();
     m = b1 * m + (S(1) - b1) * g;
     v = b2 * v + (S(1) - b2) * g.square();
-    params_->values().segment(i, len).array() -= step_size * m / (v.sqrt() * inv_sqrt_bc2 + config_.eps);
+    params_->values().segment(begin_ + i, len).array() -= step_size * m / (v.sqrt() * inv_sqrt_bc2 + config_.eps);
   }
 }
 

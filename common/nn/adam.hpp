@@ -1,4 +1,4 @@
-// Adam on a flat ParameterSet, plus global gradient-norm clipping.
+// Adam on a flat ParameterSet (or one contiguous range of it), plus global gradient-norm clipping.
 #pragma once
 
 #include <iosfwd>
@@ -20,6 +20,9 @@ template <typename S>
 class Adam {
  public:
   Adam(ParameterSet<S>& params, AdamConfig<S> config = {});
+  // Steps only the values [begin, end): parts of one model trained with their own rates (IQL's
+  // actor and value function share an ActorCritic's parameter set, policy first).
+  Adam(ParameterSet<S>& params, AdamConfig<S> config, int begin, int end);
   // One update from params.grads(); uses config().lr, which callers may change between steps.
   void step();
   AdamConfig<S>& config() { return config_; }
@@ -33,6 +36,7 @@ class Adam {
  private:
   ParameterSet<S>* params_;
   AdamConfig<S> config_;
+  int begin_ = 0, end_ = 0;
   Vec<S> m_, v_;
   long long t_ = 0;
 };

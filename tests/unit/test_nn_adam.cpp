@@ -44,6 +44,26 @@ TEST(Adam, TwoStepsMatchTheTextbookBiasCorrectedUpdate) {
   EXPECT_EQ(adam.stepCount(), 2);
 }
 
+// Two optimizers on two ranges of one set (IQL's actor and value function): each moves only its
+// own values, exactly as a whole-set Adam over those values alone would.
+TEST(Adam, RangeStepsOnlyItsValuesLikeAWholeSetAdamOverThem) {
+  ParameterSet<double> p = makeParams(5), alone = makeParams(3);
+  p.values() << 1.0, -2.0, 0.5, 3.0, -1.0;
+  alone.values() = p.values().segment(1, 3);
+  Adam<double> middle(p, AdamConfig<double>{}, 1, 4), whole(alone);
+  const Vec<double> g = (Vec<double>(5) << 0.7, 0.3, -4.0, 0.2, 9.0).finished();
+  for (int t = 0; t < 3; ++t) {
+    p.grads() = g;
+    alone.grads() = g.segment(1, 3);
+    middle.step();
+    whole.step();
+  }
+  EXPECT_EQ(p.values()(0), 1.0);
+  EXPECT_EQ(p.values()(4), -1.0);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(p.values()(1 + i), alone.values()(i)) << "index " << i + 1;
+  EXPECT_THROW(Adam<double>(p, AdamConfig<double>{}, 2, 6), std::exception);
+}
+
 TEST(Adam, LearningRateChangeBetweenStepsTakesEffect) {
   ParameterSet<double> a = makeParams(4), b = makeParams(4);
   Adam<double> opt_a(a), opt_b(b);

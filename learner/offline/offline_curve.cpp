@@ -1,0 +1,48 @@
+#include "learner/offline/offline_curve.hpp"
+
+#include <sstream>
+
+#include "learner/learning_curve.hpp"
+
+namespace masa::offline {
+namespace {
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : " ") + n;
+  return learner::gnuplotQuoted(s);
+}
+
+}  // namespace
+
+std::string offlineCurveScript(const std::string& title, const std::vector<std::string>& losses,
+                               const std::vector<std::string>& figures) {
+  std::ostringstream g;
+  g << learner::curveScriptHeader("a masa offline run", "masa_offline", title, "gradient steps")
+    << "# Rows without an evaluation say nan there: evaluations are points.\n"
+       "set title \"evaluation return (policy mean)\"\n"
+       "plot \"metrics.csv\" using \"step\":\"eval_return\" with points pt 5 ps 1.2 title \"return\"\n"
+       "set title \"evaluation success and episode length\"\n"
+       "set ytics nomirror\n"
+       "set y2tics\n"
+       "set y2range [0:1]\n"
+       "plot \"metrics.csv\" using \"step\":\"eval_length\" with points pt 7 ps 1.2 title \"length\", \\\n"
+       "     \"\" using \"step\":(column(\"eval_success\") < 0 ? NaN : column(\"eval_success\")) with points axes x1y2 pt 5 ps 1.2 title \"success\"\n"
+       "unset y2tics\n"
+       "set ytics mirror\n"
+       "set title \"losses\"\n"
+       "plot for [c in "
+    << joined(losses)
+    << "] \"metrics.csv\" using \"step\":(column(c)) pt 7 title c\n"
+       "set title \"figures\"\n";
+  if (figures.empty())
+    g << "plot \"metrics.csv\" using \"step\":\"steps_per_s\" pt 7 title \"steps / s\"\n";
+  else
+    g << "plot for [c in " << joined(figures) << "] \"metrics.csv\" using \"step\":(column(c)) pt 7 title c\n";
+  g << "set title \"throughput\"\n"
+       "plot \"metrics.csv\" using \"step\":\"steps_per_s\" pt 7 title \"gradient steps / s\"\n"
+    << learner::curveScriptFooter();
+  return g.str();
+}
+
+}  // namespace masa::offline

@@ -1,0 +1,64 @@
+#include "learner/offline/twin_q.hpp"
+
+#include "learner/offline/state_action_maps.hpp"
+
+namespace masa::offline {
+
+template <typename S>
+TwinQ<S>::TwinQ(const sym::SymmetrySpec& spec, model::Method method, const std::vector<int>& hidden,
+                nn::Activation activation)
+    : maps_(buildStateActionMaps(method, spec)),
+      obs_dim_(spec.obsDim()),
+      act_dim_(spec.actDim()),
+      q1_(params_, "q1", &maps_, hidden, {}, activation),
+      q2_(params_, "q2", &maps_, hidden, {}, activation) {
+  params_.finalize();
+}
+
+template <typename S>
+void TwinQ<S>::initialize(Rng& rng) {
+  q1_.initialize(rng);
+  q2_.initialize(rng);
+}
+
+template <typename S>
+Eigen::Block<Mat<S>> TwinQ<S>::forward(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions) {
+  MASA_CHECK(obs.rows() == obs_dim_ && actions.rows() == act_dim_ && obs.cols() == actions.cols(),
+             "Q input is " << obs.rows() << "x" << obs.cols() << " and " << actions.rows() << "x" << actions.cols()
+                           << ", expected " << obs_dim_ << " and " << act_dim_ << " rows, equal columns");
+  const Eigen::Index b = obs.cols();
+  if (pair_.cols() < b) {
+    pair_.resize(obs_dim_ + act_dim_, b);
+    q_.resize(2, b);
+  }
+  auto pair = pair_.leftCols(b);
+  pair.topRows(obs_dim_) = obs;
+  pair.bottomRows(act_dim_) = actions;
+  auto q = q_.leftCols(b);
+  q.row(0) = q1_.forward(pair);
+  q.row(1) = q2_.forward(pair);
+  return q_.block(0, 0, 2, b);
+}
+
+template <typename S>
+void TwinQ<S>::backward(const ConstMatRef<S>& dq) {
+  q1_.backward(dq.row(0));
+  q2_.backward(dq.row(1));
+}
+
+template <typename S>
+void TwinQ<S>::minQ(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions, MatRef<S> out) {
+  const auto q = forward(obs, actions);
+  out = q.row(0).cwiseMin(q.row(1));
+}
+
+template <typename S>
+void TwinQ<S>::moveTowards(const TwinQ& online, S rate) {
+  MASA_CHECK(online.params_.size() == params_.size(), "target and online Q differ in shape");
+  params_.values() += rate * (online.params_.values() - params_.values());
+}
+
+template class TwinQ<float>;
+template class TwinQ<double>;
+
+}  // namespace masa::offline
