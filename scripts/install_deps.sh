@@ -25,6 +25,9 @@ packages=(
   gnuplot-nox
   # offline datasets exported to HDF5 (and h5py, to check the export as a Python user reads it)
   libhdf5-dev python3-h5py
+  # policies exported to ONNX (masa_export): onnx's protobuf classes (libonnx-dev, which does not
+  # pull in libprotobuf-dev), and onnx's checker for the test that reads the files as a user would
+  libonnx-dev libprotobuf-dev python3-onnx
 )
 
 # --bench: also the packages that only the comparison benchmarks need (never CI, never a training

@@ -59,6 +59,7 @@ class ActorCritic {
     return params_.size();
   }
   RunningMeanStd<S>& obsNormalizer() { return obs_norm_; }
+  const RunningMeanStd<S>& obsNormalizer() const { return obs_norm_; }
   RunningMeanStd<S>& valueNormalizer() { return value_norm_; }
 
   // Training forward on raw observations (obs_dim x B); caches for backward.

@@ -31,6 +31,10 @@ class RunningMeanStd {
   double count() const { return count_; }
   const Eigen::VectorXd& mean() const { return mean_eff_; }
   const Eigen::VectorXd& var() const { return var_eff_; }
+  // What normalize() applies, in S: out = (x - shift()) * invScale(). Exporters read these so that
+  // they reproduce the normalizer to the bit (epsilon included).
+  const Vec<S>& shift() const { return shift_; }
+  const Vec<S>& invScale() const { return inv_scale_; }
 
   // Replaces the statistics with a broadcast mean and std (std already includes epsilon, > 0), as
   // an actor receives them from the learner; used as given, without symmetry projection.

@@ -101,8 +101,8 @@ LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_
 double checkPolicySymmetry(LoadedPolicy& policy, double tolerance, int samples) {
   if (policy.config.method != model::Method::kMasa) return 0.0;
   auto& model = *policy.model;
-  // Observations around the normalizer's statistics (within 2 std: the +-5 clamp of normalized
-  // inputs does not commute with rotations), actions around 0.
+  // Observations within 2 std of the normalizer's statistics (where the policy was trained; the
+  // normalizer does not clip), actions around 0.
   std::mt19937_64 rng(12345);
   std::normal_distribution<float> normal(0.0f, 1.0f);
   const auto& norm = model.obsNormalizer();
