@@ -95,7 +95,7 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
 
   if (!transport_) {
     owned_transport_ =
-        std::make_unique<transport::Transport>(options_.url.empty() ? transport::loopbackUrl() : options_.url);
+        std::make_unique<transport::Transport>(options_.url.empty() ? transport::loopbackUrl() : options_.url, options_.run_key);
     transport_ = owned_transport_.get();
   }
   char host[256] = {};

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@ struct ActorOptions {
   int num_envs = 1;
   int64_t run_id = 0;
   std::string url;               // "" -> transport::loopbackUrl(); ignored with an external transport
+  // Authenticates every message (common/transport/message_auth.hpp): the learner's run key. None:
+  // unsigned (--no-auth). Ignored with an external transport.
+  std::optional<transport::RunKey> run_key;
   int64_t max_rollouts = -1;     // < 0: until stopped
   int threads = 1;               // OpenMP threads over environments
   bool start_without_learner = false;  // act with own initial parameters as version 0

@@ -1,6 +1,7 @@
 // masa_actor: one actor process. Steps --num-envs environments of the configured task, acting with
 // the parameters the learner broadcasts for --run-id, and streams rollouts back over LCM.
-//   masa_actor --set task=a1_beam --actor-id 0 --num-envs 64 --run-id 42
+//   masa_actor --set task=a1_beam --actor-id 0 --num-envs 64 --run-id 42 --key-file RUN_DIR/run.key
+// Every message is authenticated with the learner's run key (--key-file); --no-auth turns that off.
 // Exit status 0 on a clean stop (SIGINT/SIGTERM or --max-rollouts), 2 on bad input.
 #include <csignal>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include "actors/actor.hpp"
 #include "common/config/run_config.hpp"
 #include "common/transport/lcm_url.hpp"
+#include "common/transport/run_key.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -56,6 +58,12 @@ int main(int argc, char** argv) {
                  "rollout_seq of the first rollout (default: the wall clock in microseconds, so a restarted "
                  "actor's rollouts are told apart from its previous process's)")
       ->check(CLI::NonNegativeNumber);
+  std::string key_file;
+  bool no_auth = false;
+  auto* key_opt = app.add_option("--key-file", key_file,
+                                 "the learner's run key (its RUN_DIR/run.key), which every message is authenticated with");
+  app.add_flag("--no-auth", no_auth, "send and accept messages without authentication (anyone on the network can "
+                                     "then make this actor act with their parameters)")->excludes(key_opt);
   // Fault injection for tests of the learner's loss handling; never for training.
   app.add_option("--drop-chunks-percent", opt.drop_chunks_percent,
                  "FAULT INJECTION (tests only): throw away this percentage of rollout chunks instead of sending them")
@@ -63,12 +71,25 @@ int main(int argc, char** argv) {
   app.add_option("--drop-seed", opt.drop_seed, "seed of the generator that picks the chunks to throw away")
       ->capture_default_str()->group("Fault injection");
   CLI11_PARSE(app, argc, argv);
+  if (key_file.empty() && !no_auth) {
+    std::fprintf(stderr, "masa_actor: no run key: give --key-file RUN_DIR/run.key (the learner's), or --no-auth to "
+                         "run without message authentication\n");
+    return 2;
+  }
 
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   opt.stop = &g_stop;
   try {
     const auto rc = masa::config::loadRunConfig(configs, overrides, run_config);
+    if (no_auth) {
+      std::fprintf(stderr, "masa_actor %d: WARNING: --no-auth: messages are neither signed nor checked; anyone who "
+                           "can reach this network can make this actor act with their parameters\n", opt.actor_id);
+    } else {
+      opt.run_key = masa::transport::readRunKey(key_file);
+      std::fprintf(stderr, "masa_actor %d: messages authenticated with the run key %s (key id %s)\n", opt.actor_id,
+                   key_file.c_str(), opt.run_key->id().c_str());
+    }
     masa::actor::Actor actor(rc, opt);
     std::fprintf(stderr, "masa_actor %d: task %s, %d envs, horizon %d, run %lld; %s\n", opt.actor_id,
                  rc.task.c_str(), opt.num_envs, rc.ppo.horizon, static_cast<long long>(opt.run_id),

@@ -10,6 +10,9 @@
 #   deploy/train.sh --resume RUN_DIR [--actors K] [--envs E] [--updates N]   (N counts all updates)
 # FILE has one host per line, "host [actors] [envs]" (default 1 actor of E environments), '#'
 # comments; "localhost" runs its actors here without ssh. See deploy/hosts.example.
+# Every message is authenticated with the run's key, RUN_DIR/run.key (made here before anything
+# starts, kept on --resume, carried to each host over the remote shell's stdin); --no-auth runs
+# without (docs/reliability.md, "Message authentication").
 # MASA_BUILD_DIR (default build) and MASA_RUNS_DIR (default runs) choose the folders, MASA_LCM_URL
 # the LCM URL (default: multicast with the largest receive buffer the kernel allows). With --hosts:
 #   MASA_REMOTE_SHELL      how to run a command on a host (default "ssh -o BatchMode=yes"); it is
@@ -25,7 +28,7 @@ cd "$(dirname "$0")/.."
 task=a1_beam method=masa task_given=0 method_given=0
 [ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; task_given=1; shift; }
 [ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; method_given=1; shift; }
-actors=2 envs=32 envs_given=0 updates="" hosts_file="" actors_given=0 resume="" recipe="" run_dir_given=""
+actors=2 envs=32 envs_given=0 updates="" hosts_file="" actors_given=0 resume="" recipe="" run_dir_given="" no_auth=0
 sets=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -37,6 +40,7 @@ while [ $# -gt 0 ]; do
     --updates) updates=$2; shift 2 ;;
     --hosts) hosts_file=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
+    --no-auth) no_auth=1; shift ;;
     *) echo "train.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
@@ -127,6 +131,15 @@ else
   fi
 fi
 
+# The run key, before anything starts: the learner and every actor read it at start-up.
+if [ "$no_auth" = 1 ]; then
+  auth=(--no-auth)
+  echo "train.sh: WARNING: --no-auth: messages are not authenticated; anyone on the network can feed this run" >&2
+else
+  bash deploy/run_key.sh "$run_dir/run.key"
+  auth=(--key-file "$run_dir/run.key")
+fi
+
 # Keep-alive pipe: every actor's and the learner's tethered.sh reads it on stdin, and only this
 # script holds its write end (children close it), so when this script ends in any way, even by
 # SIGKILL, each of them sees end of file and stops its program: nothing is left running, here or
@@ -141,12 +154,13 @@ if [ -z "$hosts_file" ]; then
   echo "train.sh: $task / $method, $actors actors x $envs envs, $updates updates, run dir $run_dir"
   # The learner may be in an update when told to stop: give it time to finish and checkpoint.
   MASA_TETHER_GRACE_S=300 bash deploy/tethered.sh "$build/learner/masa_learner" "${common[@]+"${common[@]}"}" \
-    --url "$url" --run-id "$run_id" "${learner_run[@]}" --max-updates "$updates" <&"$alive_in" {keep}>&- {alive_in}<&- &
+    --url "$url" --run-id "$run_id" "${learner_run[@]}" "${auth[@]}" --max-updates "$updates" \
+    <&"$alive_in" {keep}>&- {alive_in}<&- &
   learner=$!
   pids=()
   for ((a = 0; a < actors; ++a)); do
     OMP_NUM_THREADS=1 bash deploy/tethered.sh "$build/actors/masa_actor" "${actor_config[@]+"${actor_config[@]}"}" \
-      "${common[@]+"${common[@]}"}" --url "$url" --run-id "$run_id" --actor-id "$a" --num-envs "$envs" \
+      "${common[@]+"${common[@]}"}" --url "$url" --run-id "$run_id" "${auth[@]}" --actor-id "$a" --num-envs "$envs" \
       <&"$alive_in" >> "$run_dir/actor$a.log" 2>&1 {keep}>&- {alive_in}<&- &
     pids+=($!)
   done
@@ -174,9 +188,23 @@ remote_dir=${MASA_REMOTE_DIR:-$PWD}
 remote_build=${MASA_REMOTE_BUILD_DIR:-$build}
 
 echo "train.sh: $task / $method over $url, $actors actors on ${#hosts[@]} hosts ($total_envs envs), $updates updates, run dir $run_dir"
+
+# The run key goes to each actor host before anything starts, on the remote shell's stdin (never on
+# a command line: `ps` shows those), to the same path under MASA_REMOTE_DIR, mode 0600. Written
+# under a temporary name and renamed: a host that shares this file system keeps the one key.
+if [ "$no_auth" = 0 ]; then
+  for h in $(printf '%s\n' "${hosts[@]}" | sort -u); do
+    [ "$h" = localhost ] && continue
+    key_q=$(printf %q "$run_dir/run.key")
+    carry="cd $(printf %q "$remote_dir") && mkdir -p $(printf %q "$run_dir") && umask 077 && cat > $key_q.tmp.\$\$ && mv -f $key_q.tmp.\$\$ $key_q"
+    "${remote_shell[@]}" "$h" "$carry" < "$run_dir/run.key" ||
+      { echo "train.sh: cannot carry the run key to $h (to $remote_dir/$run_dir/run.key there)" >&2; exit 2; }
+  done
+fi
+
 # The learner may be in an update when told to stop: give it time to finish and checkpoint.
 MASA_TETHER_GRACE_S=300 bash deploy/tethered.sh "$build/learner/masa_learner" "${common[@]}" --url "$url" \
-  --run-id "$run_id" --run-dir "$run_dir" --max-updates "$updates" <&"$alive_in" {keep}>&- {alive_in}<&- &
+  --run-id "$run_id" --run-dir "$run_dir" "${auth[@]}" --max-updates "$updates" <&"$alive_in" {keep}>&- {alive_in}<&- &
 learner=$!
 pids=() pid_actor=()
 a=0
@@ -186,7 +214,7 @@ for i in "${!hosts[@]}"; do
     # localhost: this repository and build; another host: MASA_REMOTE_DIR and MASA_REMOTE_BUILD_DIR there.
     dir=$remote_dir bin_dir=$remote_build
     [ "$h" = localhost ] && dir=$PWD bin_dir=$build
-    actor_cmd=("$bin_dir/actors/masa_actor" "${common[@]}" --url "$url" --run-id "$run_id" --actor-id "$a"
+    actor_cmd=("$bin_dir/actors/masa_actor" "${common[@]}" --url "$url" --run-id "$run_id" "${auth[@]}" --actor-id "$a"
                --num-envs "${host_envs[i]}")
     cmd="cd $(printf %q "$dir") && exec env OMP_NUM_THREADS=1 bash deploy/tethered.sh $(printf '%q ' "${actor_cmd[@]}")"
     log="$run_dir/actor$a.log"

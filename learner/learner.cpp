@@ -82,7 +82,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   assembler_ = std::make_unique<transport::RolloutAssembler>(assemblerConfig(run_id_, rc_, model_->obsDim(), model_->actDim()));
   assembler_->setLearnerVersion(version_);
 
-  transport_ = std::make_unique<transport::Transport>(opt_.url);
+  transport_ = std::make_unique<transport::Transport>(opt_.url, opt_.run_key);
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
 
   if (rc_.runner.eval_every > 0) {
@@ -117,7 +117,14 @@ double Learner::wallTime() const {
   return wall_offset_s_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-int64_t Learner::droppedChunks() const { return assembler_->stats().dropped(); }
+transport::DropStats Learner::dropStats() const {
+  transport::DropStats s = assembler_->stats();
+  s.count[static_cast<int>(transport::DropReason::kUnauthenticated)] =
+      transport_->rejected(transport::kRolloutChannel)[static_cast<int>(transport::WireVerdict::kUnauthenticated)];
+  return s;
+}
+
+int64_t Learner::droppedChunks() const { return dropStats().dropped(); }
 
 int64_t Learner::droppedEnvs() const {
   return collector_ ? collector_->stats().envs_stale + collector_->stats().envs_overflow : 0;
@@ -352,10 +359,11 @@ void Learner::publishStats() {
   s.learning_rate = static_cast<float>(p.lr);
   s.grad_norm = static_cast<float>(p.grad_norm);
   s.explained_variance = static_cast<float>(p.explained_variance);
-  // Assembler reasons (chunks), then the collector's own drops (environments).
+  // Chunk reasons, then the collector's own drops (environments).
+  const transport::DropStats chunks = dropStats();
   for (int r = 1; r < transport::kNumDropReasons; ++r) {
     s.drop_reason_names.emplace_back(transport::dropReasonName(static_cast<transport::DropReason>(r)));
-    s.drop_counts.push_back(assembler_->stats().count[r]);
+    s.drop_counts.push_back(chunks.count[r]);
   }
   s.drop_reason_names.emplace_back("stale_in_collector");
   s.drop_counts.push_back(collector_ ? collector_->stats().envs_stale : 0);

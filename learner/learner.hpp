@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct LearnerOptions {
   std::string run_dir;        // created if missing
   int64_t run_id = 0;         // 0: random from the clock, or the checkpoint's when resuming
   bool resume = false;        // load <run_dir>/checkpoint.bin and append to metrics.csv
+  // Authenticates every message (common/transport/message_auth.hpp); none: unsigned (--no-auth,
+  // or in-process memq runs).
+  std::optional<transport::RunKey> run_key;
   bool verbose = true;  // one progress line per update on stdout
 };
 
@@ -86,7 +90,8 @@ class Learner {
   int64_t envSteps() const { return env_steps_; }
   const std::string& runDir() const { return dir_; }
   const model::ActorCritic<float>& model() const { return *model_; }
-  const transport::DropStats& dropStats() const { return assembler_->stats(); }
+  // The assembler's counts, and the chunks the transport dropped for want of a valid tag.
+  transport::DropStats dropStats() const;
   // One unit each: rollout chunks the assembler dropped (or counted lost), and environments the
   // collector dropped (stale or overflowing its pool).
   int64_t droppedChunks() const;

@@ -2,11 +2,14 @@
 // broadcasts parameters.
 //   masa_learner --set task=trifinger_lift --set method=masa
 //   masa_learner --resume runs/trifinger_lift_masa_0_20260101-120000
+// Every message is authenticated with the run key (--key-file, default RUN_DIR/run.key, made when
+// missing); --no-auth turns that off.
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <csignal>
 #include <ctime>
 #include <exception>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -15,6 +18,7 @@
 #include "common/model/method.hpp"
 #include "common/transport/drop_reason.hpp"
 #include "common/transport/lcm_url.hpp"
+#include "common/transport/run_key.hpp"
 #include "learner/learner.hpp"
 
 namespace {
@@ -51,6 +55,13 @@ int main(int argc, char** argv) {
   app.add_option("--url", url, "LCM provider URL")->capture_default_str();
   app.add_option("--run-id", run_id, "run id actors must carry (default: random, or the checkpoint's)");
   app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_epochs)");
+  std::string key_file;
+  bool no_auth = false;
+  auto* key_opt = app.add_option("--key-file", key_file,
+                                 "the run key every message is authenticated with (default: RUN_DIR/run.key, made "
+                                 "when missing; give the actors the same file)");
+  app.add_flag("--no-auth", no_auth, "send and accept messages without authentication (anyone on the network can "
+                                     "then feed this run rollouts)")->excludes(key_opt);
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -69,6 +80,16 @@ int main(int argc, char** argv) {
                                            std::to_string(rc.seed) + "_" + timestamp();
     }
     if (max_updates < 0) max_updates = rc.ppo.max_epochs;
+    if (no_auth) {
+      std::cerr << "masa_learner: WARNING: --no-auth: messages are neither signed nor checked; anyone who can "
+                   "reach this network can feed this run rollouts\n";
+    } else {
+      std::filesystem::create_directories(opt.run_dir);
+      if (key_file.empty()) key_file = (std::filesystem::path(opt.run_dir) / "run.key").string();
+      opt.run_key = masa::transport::readOrCreateRunKey(key_file);
+      std::cout << "masa_learner: messages authenticated with the run key " << key_file << " (key id "
+                << opt.run_key->id() << ")" << std::endl;
+    }
 
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);

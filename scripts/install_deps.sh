@@ -15,6 +15,8 @@ packages=(
   # transport, tools and Java bindings (lcm-spy needs a JDK to build the types jar, and jchart2d)
   # (liblcm-dev needs glib headers but does not pull them in)
   liblcm-dev libglib2.0-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java
+  # message authentication (HMAC-SHA256 of the run key, from OpenSSL's libcrypto)
+  libssl-dev
   # tests and benchmarks (iproute2 and nftables: the multi-host tests over network namespaces)
   libgtest-dev libgmock-dev libbenchmark-dev iproute2 nftables
   # actors on other machines (deploy/train.sh --hosts)

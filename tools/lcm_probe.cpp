@@ -8,6 +8,8 @@
 // The latency includes what the publisher does after stamping utime (encoding, sending every
 // fragment), the network, LCM's reassembly and the probe's own scheduling: under load, it is what
 // a subscriber that polls without delay would see.
+// With --key-file (a run's run.key) only messages with a valid tag count, the others are reported
+// as unauthenticated; without it, a message's tag is skipped unchecked (the probe only watches).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -24,6 +26,8 @@
 
 #include "common/transport/channels.hpp"
 #include "common/transport/lcm_url.hpp"
+#include "common/transport/message_auth.hpp"
+#include "common/transport/run_key.hpp"
 #include "common/transport/transport.hpp"
 #include "common/transport/wire_guard.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
@@ -72,7 +76,7 @@ double percentile(const std::vector<double>& sorted, double p) {
 }
 
 struct ChannelLog {
-  int64_t messages = 0, bytes = 0, undecoded = 0;
+  int64_t messages = 0, bytes = 0, undecoded = 0, unauthenticated = 0;
   std::vector<double> sizes, latencies_ms;
   std::map<int64_t, int> versions;  // policy version -> times received (repeats are normal)
   int64_t first_us = 0, last_us = 0;
@@ -96,6 +100,8 @@ int main(int argc, char** argv) {
   app.add_option("--run-id", run_id, "count only messages of this run (0: any run)");
   app.add_option("--csv", csv_path, "write one row per message: channel,recv_us,utime,latency_us,bytes,version");
   app.add_flag("--quiet", quiet, "print the summary only, not one line per message");
+  std::string key_file;
+  app.add_option("--key-file", key_file, "the run's run.key: count only messages with a valid tag (default: tags unchecked)");
   CLI11_PARSE(app, argc, argv);
   if (all)
     channels = {transport::kPolicyChannel, transport::kLearnerStatsChannel, transport::kHeartbeatChannel,
@@ -115,12 +121,15 @@ int main(int argc, char** argv) {
   std::map<std::string, ChannelLog> logs;
   int64_t total = 0;
   try {
-    transport::Transport bus(url);
+    std::optional<transport::RunKey> key;
+    if (!key_file.empty()) key = transport::readRunKey(key_file);
+    transport::Transport bus(url, key);
     if (!bus.recvBufCheck().sufficient) std::fprintf(stderr, "masa_lcm_probe: %s\n", bus.recvBufCheck().message.c_str());
     for (const std::string& ch : channels) {
       logs[ch];
       bus.subscribeRaw(ch, [&, ch](const void* data, int size) {
         const int64_t now = transport::wallClockMicros();  // first: decoding is not the network's time
+        if (!key) size = transport::sizeBeforeTrailer(data, size);
         const auto stamp = readStamp(ch, data, size);
         if (stamp && run_id != 0 && stamp->run_id != run_id) return;
         ChannelLog& log = logs[ch];
@@ -148,7 +157,8 @@ int main(int argc, char** argv) {
     }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
-    std::fprintf(stderr, "masa_lcm_probe: listening on %s\n", url.c_str());
+    std::fprintf(stderr, "masa_lcm_probe: listening on %s; %s\n", url.c_str(),
+                 key ? ("tags checked with run key id " + key->id()).c_str() : "tags not checked (no --key-file)");
     const auto start = std::chrono::steady_clock::now();
     while (!g_stop.load()) {
       if (bus.handleTimeout(100) < 0) {
@@ -161,6 +171,8 @@ int main(int argc, char** argv) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= duration_s)
         break;
     }
+    for (auto& [ch, log] : logs)
+      log.unauthenticated = bus.rejected(ch)[static_cast<int>(transport::WireVerdict::kUnauthenticated)];
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_lcm_probe: %s\n", e.what());
     return 2;
@@ -192,6 +204,9 @@ int main(int argc, char** argv) {
     if (log.undecoded > 0)
       std::printf("  %s: %lld messages did not decode as the channel's type\n", ch.c_str(),
                   static_cast<long long>(log.undecoded));
+    if (log.unauthenticated > 0)
+      std::printf("  %s: %lld messages without a valid tag of the run key, not counted above\n", ch.c_str(),
+                  static_cast<long long>(log.unauthenticated));
   }
   return 0;
 }

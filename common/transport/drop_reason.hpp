@@ -19,6 +19,9 @@ enum class DropReason : int {
   kTooOld,         // policy_version older than current - max_policy_lag
   kDuplicate,      // the same (actor, rollout, chunk) already arrived, or its rollout is too far behind to tell
   kOutOfRange,     // an index or enumerated value out of its range (chunk index, env range, final index, flags)
+  // Never a verdict of the assembler: no valid tag of the run key, dropped by the Transport before
+  // the assembler sees the bytes (so it moves no actor's state); the learner adds its count.
+  kUnauthenticated,
   // Never a verdict: chunks that never arrived (UDP loss, a full receive buffer, an actor killed
   // while sending), counted by the assembler from the gaps in each actor's rollout numbering.
   kLost,

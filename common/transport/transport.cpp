@@ -1,6 +1,7 @@
 #include "common/transport/transport.hpp"
 
 #include <chrono>
+#include <cstring>
 #include <iostream>
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
@@ -12,7 +13,11 @@ int64_t wallClockMicros() {
       .count();
 }
 
-Transport::Transport(const std::string& url) : url_(url) {
+Transport::Transport(const std::string& url, const std::optional<RunKey>& key) : url_(url) {
+  if (key) {
+    auth_ = std::make_unique<MessageAuthenticator>(*key);
+    key_id_ = key->id();
+  }
   const int64_t requested = recvBufSizeOf(url);
   if (requested > 0) {
     recv_buf_ = checkRecvBuf(requested);
@@ -29,19 +34,52 @@ Transport::~Transport() {
   for (Sub& s : subs_) lcm_unsubscribe(lcm_->getUnderlyingLCM(), s.lcm_sub);
 }
 
-bool Transport::publishRaw(const std::string& channel, const void* data, int size) {
+bool Transport::publishWire(const std::string& channel, const void* data, int size) {
   return lcm_->publish(channel, data, static_cast<unsigned int>(size)) == 0;
+}
+
+bool Transport::publishRaw(const std::string& channel, const void* data, int size) {
+  if (!auth_) return publishWire(channel, data, size);
+  std::lock_guard<std::mutex> lock(publish_mutex_);
+  uint8_t* buf = publishBuffer(size);
+  if (size > 0) std::memcpy(buf, data, static_cast<std::size_t>(size));
+  return sendPublishBuffer(channel, size);
+}
+
+uint8_t* Transport::publishBuffer(int size) {
+  const std::size_t needed = static_cast<std::size_t>(size) + (auth_ ? kAuthTrailerBytes : 0);
+  if (publish_buf_.size() < needed) publish_buf_.resize(needed);
+  return publish_buf_.data();
+}
+
+bool Transport::sendPublishBuffer(const std::string& channel, int size) {
+  if (auth_) {
+    auth_->seal(channel, publish_buf_.data(), size, publish_buf_.data() + size);
+    size += kAuthTrailerBytes;
+  }
+  return publishWire(channel, publish_buf_.data(), size);
+}
+
+void Transport::deliver(const Sub& sub, const char* channel, const void* data, int size) {
+  if (auth_) {
+    // The channel it arrived on, as LCM reports it: the tag must be for this one.
+    size = auth_->open(channel, data, size);
+    if (size < 0) return countRejected(channel, WireVerdict::kUnauthenticated);
+  }
+  sub.handler(data, size);
 }
 
 Transport::SubscriptionId Transport::subscribeRaw(const std::string& channel, RawHandler handler) {
   Sub& s = subs_.emplace_back();
   s.id = next_id_++;
   s.handler = std::move(handler);
+  s.owner = this;
   // The C API, because lcm-cpp hides a failed subscribe behind a Subscription that never fires.
   s.lcm_sub = lcm_subscribe(
       lcm_->getUnderlyingLCM(), channel.c_str(),
-      [](const lcm_recv_buf_t* rb, const char*, void* user) {
-        static_cast<Sub*>(user)->handler(rb->data, static_cast<int>(rb->data_size));
+      [](const lcm_recv_buf_t* rb, const char* channel, void* user) {
+        const Sub& sub = *static_cast<const Sub*>(user);
+        sub.owner->deliver(sub, channel, rb->data, static_cast<int>(rb->data_size));
       },
       &s);
   if (s.lcm_sub == nullptr) {
@@ -81,7 +119,11 @@ void Transport::countRejected(const std::string& channel, WireVerdict why) {
   int64_t total = 0;
   for (int64_t n : r.count) total += n;
   std::cerr << "masa transport: rejected " << r.unwarned << " message(s) on " << channel << " (latest: "
-            << wireVerdictName(why) << "); " << total << " rejected on this channel so far\n";
+            << wireVerdictName(why) << "); " << total << " rejected on this channel so far";
+  if (why == WireVerdict::kUnauthenticated)
+    std::cerr << " (unsigned, or signed with another key: do all processes of the run share its run.key? our key id "
+              << key_id_ << ")";
+  std::cerr << "\n";
   r.warned = true;
   r.last_warning = now;
   r.unwarned = 0;

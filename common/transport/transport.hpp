@@ -3,6 +3,11 @@
 // publish/subscribe and a bounded wait. Nothing above this layer includes lcm-cpp.hpp, so the
 // transport could be replaced without touching actors or the learner.
 //
+// With a run key, it authenticates every message (message_auth.hpp): publishing appends the
+// key's trailer, and a received message without a valid one is counted (kUnauthenticated) and
+// never reaches a handler; the others reach it without their trailer, byte for byte as published.
+// Without a key, bytes pass unchanged both ways (in-process memq runs, robot channels, --no-auth).
+//
 // Threading: publish() may be called from any thread; handle*() and (un)subscribe() from one
 // thread (handlers run on the thread that calls handle*()).
 #pragma once
@@ -15,10 +20,13 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/transport/lcm_url.hpp"
+#include "common/transport/message_auth.hpp"
+#include "common/transport/run_key.hpp"
 #include "common/transport/wire_guard.hpp"
 
 namespace lcm {
@@ -43,19 +51,24 @@ class Transport {
 
   // "" uses LCM_DEFAULT_URL (or LCM's own default). Throws std::runtime_error when LCM cannot
   // start on the URL. For a udpm URL, warns on stderr when net.core.rmem_max is below the
-  // requested recv_buf_size (see recvBufCheck()).
-  explicit Transport(const std::string& url);
+  // requested recv_buf_size (see recvBufCheck()). With `key`, every message is authenticated.
+  explicit Transport(const std::string& url, const std::optional<RunKey>& key = std::nullopt);
   ~Transport();
   Transport(const Transport&) = delete;
   Transport& operator=(const Transport&) = delete;
 
   const std::string& url() const { return url_; }
   const RecvBufCheck& recvBufCheck() const { return recv_buf_; }
+  bool authenticates() const { return auth_ != nullptr; }
 
-  // Encodes into a reused buffer and publishes; returns false when LCM reports a failure.
+  // Encodes into a reused buffer, appends the run key's trailer (with a key) and publishes;
+  // returns false when LCM reports a failure. publishRaw does the same for encoded bytes.
   template <class Msg>
   bool publish(const std::string& channel, const Msg& msg);
   bool publishRaw(const std::string& channel, const void* data, int size);
+  // The bytes exactly as given, with no trailer even with a key: what any machine on the LAN can
+  // send. For tests and tools that forge or replay traffic.
+  bool publishWire(const std::string& channel, const void* data, int size);
 
   // Raw bytes, for handlers that decode into a reused message (rollout chunks: see
   // RolloutAssembler::acceptEncoded) or only measure them; a handler that decodes must do so with
@@ -74,18 +87,25 @@ class Transport {
   // Dispatches every message already queued (without waiting); returns how many.
   int drain();
 
-  // Messages rejected by subscribe()'s guard: on all channels, and on one per reason.
+  // Messages rejected before their handler (no valid tag with a key, or subscribe()'s guard):
+  // on all channels, and on one per reason.
   int64_t decodeErrors() const { return decode_errors_; }
   WireRejects rejected(const std::string& channel) const;
 
  private:
-  void countRejected(const std::string& channel, WireVerdict why);
-
   struct Sub {
     SubscriptionId id;
     RawHandler handler;
+    Transport* owner = nullptr;
     _lcm_subscription_t* lcm_sub = nullptr;  // LCM's C API: it reports a failed subscribe
   };
+
+  void deliver(const Sub& sub, const char* channel, const void* data, int size);
+  void countRejected(const std::string& channel, WireVerdict why);
+  // The reused publish buffer, with room for `size` bytes and a trailer; the caller holds publish_mutex_.
+  uint8_t* publishBuffer(int size);
+  // Seals the first `size` bytes of the publish buffer (with a key) and publishes them.
+  bool sendPublishBuffer(const std::string& channel, int size);
 
   std::string url_;
   RecvBufCheck recv_buf_;
@@ -100,6 +120,8 @@ class Transport {
     int64_t unwarned = 0;  // rejected since the last warning
   };
   std::map<std::string, ChannelRejects> rejects_;
+  std::unique_ptr<MessageAuthenticator> auth_;  // null: no key
+  std::string key_id_;                           // RunKey::id(), for the warnings
   std::mutex publish_mutex_;
   std::vector<uint8_t> publish_buf_;
 };
@@ -108,9 +130,8 @@ template <class Msg>
 bool Transport::publish(const std::string& channel, const Msg& msg) {
   std::lock_guard<std::mutex> lock(publish_mutex_);
   const int size = msg.getEncodedSize();
-  if (static_cast<int>(publish_buf_.size()) < size) publish_buf_.resize(size);
-  if (msg.encode(publish_buf_.data(), 0, size) != size) return false;
-  return publishRaw(channel, publish_buf_.data(), size);
+  if (msg.encode(publishBuffer(size), 0, size) != size) return false;
+  return sendPublishBuffer(channel, size);
 }
 
 template <class Msg>

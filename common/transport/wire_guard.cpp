@@ -50,6 +50,7 @@ std::string_view wireVerdictName(WireVerdict v) {
     case WireVerdict::kOverLimit: return "over_limit";
     case WireVerdict::kBadString: return "bad_string";
     case WireVerdict::kDecodeFailed: return "decode_failed";
+    case WireVerdict::kUnauthenticated: return "unauthenticated";
     case WireVerdict::kCount: break;
   }
   return "unknown";

@@ -31,6 +31,7 @@ enum class WireVerdict : int {
   kOverLimit,       // an array or string longer than WireLimits allows
   kBadString,       // a string without its terminating NUL, with a NUL inside, or of length 0
   kDecodeFailed,    // the guard passed but lcm-gen's decoder did not consume exactly the bytes
+  kUnauthenticated, // no trailer of the run key that verifies (Transport with a key, message_auth.hpp)
   kCount
 };
 inline constexpr int kNumWireVerdicts = static_cast<int>(WireVerdict::kCount);

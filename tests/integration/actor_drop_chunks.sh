@@ -11,12 +11,7 @@ source tests/integration/lib.sh
 
 port=${1:-7672}
 percent=${2:-30}
-url="udpm://239.255.76.67:$port?ttl=0"
-run_id=$(( ($(date +%s%N) / 1000) % 2000000000 + 1 ))
-work=$(mktemp -d "${TMPDIR:-/tmp}/masa_drop_chunks.XXXXXX")
-run="$work/run"
-trap 'kill_started' EXIT
-require_binaries
+begin_local_run drop_chunks "$port"
 
 log "learner and 2 actors throwing away $percent% of their chunks, on $url (work dir $work)"
 start_learner "$run" "$url" "$run_id"

@@ -12,12 +12,7 @@ cd "$(dirname "$0")/../.."
 source tests/integration/lib.sh
 
 port=${1:-7671}
-url="udpm://239.255.76.67:$port?ttl=0"
-run_id=$(( ($(date +%s%N) / 1000) % 2000000000 + 1 ))
-work=$(mktemp -d "${TMPDIR:-/tmp}/masa_kill_restart.XXXXXX")
-run="$work/run"
-trap 'kill_started' EXIT
-require_binaries
+begin_local_run kill_restart "$port"
 
 log "learner and actors 0, 1 on $url (work dir $work)"
 start_learner "$run" "$url" "$run_id" --set runner.silence_warn_s=6

@@ -6,6 +6,7 @@ build=${MASA_BUILD_DIR:-build}
 [[ "$build" = /* ]] || build="$PWD/$build"
 learner_bin="$build/learner/masa_learner"
 actor_bin="$build/actors/masa_actor"
+masa_repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 
 # Small networks and batches: these tests are about the system, not learning. 2 actors x 8 envs.
 test_sets=(--set task=a1_beam --set method=masa --set ppo.num_envs=16 --set ppo.horizon=32
@@ -28,6 +29,18 @@ require_binaries() {
   for b in "$learner_bin" "$actor_bin"; do
     [ -x "$b" ] || { echo "FAIL: $b is missing: build first (MASA_BUILD_DIR=$build)"; exit 1; }
   done
+}
+
+# begin_local_run NAME PORT: a test's processes on this machine's loopback multicast: sets url
+# (ttl=0, on PORT), a fresh run_id, work (a new folder) and run ($work/run); what the test starts
+# is killed when it exits.
+begin_local_run() {
+  url="udpm://239.255.76.67:$2?ttl=0"
+  run_id=$(( ($(date +%s%N) / 1000) % 2000000000 + 1 ))
+  work=$(mktemp -d "${TMPDIR:-/tmp}/masa_$1.XXXXXX")
+  run="$work/run"
+  trap 'kill_started' EXIT
+  require_binaries
 }
 
 # Stops every process this test started, by pid.
@@ -59,11 +72,23 @@ wait_until() {
 
 at_least_updates() { [ "$(updates_in "$1")" -ge "$2" ]; }
 
+# Sets auth=(--key-file $work/run.key), the run key every process of a test shares (made on first
+# use), or auth=() when the arguments given already choose (--key-file or --no-auth).
+set_auth() {
+  local a
+  for a in "$@"; do
+    [[ "$a" == --key-file || "$a" == --no-auth ]] && { auth=(); return 0; }
+  done
+  bash "$masa_repo/deploy/run_key.sh" "$work/run.key"
+  auth=(--key-file "$work/run.key")
+}
+
 # start_learner RUN_DIR URL RUN_ID [extra args...]: a learner in the background, log in RUN_DIR/../learner.log.
 start_learner() {
   local dir=$1 url=$2 rid=$3
   shift 3
-  "$learner_bin" "${test_sets[@]}" --url "$url" --run-id "$rid" --run-dir "$dir" --max-updates 100000 "$@" \
+  set_auth "$@"
+  "$learner_bin" "${test_sets[@]}" --url "$url" --run-id "$rid" --run-dir "$dir" --max-updates 100000 "${auth[@]+"${auth[@]}"}" "$@" \
     > "$work/learner.log" 2>&1 &
   learner_pid=$!
   started_pids+=("$learner_pid")
@@ -73,7 +98,8 @@ start_learner() {
 start_actor() {
   local id=$1 url=$2 rid=$3
   shift 3
-  OMP_NUM_THREADS=1 "$actor_bin" "${test_sets[@]}" --url "$url" --run-id "$rid" --actor-id "$id" --num-envs 8 "$@" \
+  set_auth "$@"
+  OMP_NUM_THREADS=1 "$actor_bin" "${test_sets[@]}" --url "$url" --run-id "$rid" --actor-id "$id" --num-envs 8 "${auth[@]+"${auth[@]}"}" "$@" \
     >> "$work/actor$id.log" 2>&1 &
   actor_pid=$!
   started_pids+=("$actor_pid")

@@ -23,21 +23,7 @@ namespace masa::transport {
 namespace {
 
 using testing::encode;
-
-masa::lcmt_policy_params samplePolicy() {
-  masa::lcmt_policy_params p{};
-  p.run_id = 42;
-  p.utime = 1'700'000'000'000'000;
-  p.version = 17;
-  p.method = "masa";
-  p.task = "a1_beam";
-  p.num_params = 40;
-  for (int i = 0; i < p.num_params; ++i) p.params.push_back(0.01f * static_cast<float>(i) - 0.2f);
-  p.obs_dim = 6;
-  p.obs_mean.assign(6, 0.5f);
-  p.obs_std.assign(6, 2.0f);
-  return p;
-}
+using testing::samplePolicy;
 
 masa::lcmt_actor_heartbeat sampleHeartbeat() {
   masa::lcmt_actor_heartbeat h{};

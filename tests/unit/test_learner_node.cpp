@@ -16,6 +16,7 @@
 #include "common/config/run_config.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
+#include "common/transport/message_auth.hpp"
 #include "common/transport/rollout_chunker.hpp"
 #include "learner/learner.hpp"
 #include "masa/lcmt_learner_stats.hpp"
@@ -210,6 +211,44 @@ TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTri
   EXPECT_EQ(cell("dropped_chunks"), std::to_string(foreign + 1 + nan_chunks));
   EXPECT_EQ(cell("dropped_envs"), "0");
   EXPECT_EQ(cell("dropped"), "(no column dropped)");
+  fs::remove_all(dir);
+}
+
+TEST(LearnerNode, WithARunKeyChunksSignedWithAnotherKeyAreCountedUnauthenticatedAndTheRunKeysAreTrainedOn) {
+  const auto rc = smallConfig();
+  const fs::path dir = freshDir("auth");
+  LearnerOptions o = options(dir, 8);
+  o.run_key = transport::RunKey::random();
+  Learner learner(rc, o);
+  masa::lcmt_learner_stats stats;
+  learner.transport().subscribe<masa::lcmt_learner_stats>(
+      transport::kLearnerStatsChannel, [&](const masa::lcmt_learner_stats& m) { stats = m; });
+  FakeActor actor(rc, 4);
+  // A whole batch of this run, as an actor with another key sends it.
+  const transport::MessageAuthenticator other(transport::RunKey::random());
+  const auto chunks = actor.chunker.split(actor.rollout, {8, 0, 0, 0});
+  for (const auto& c : chunks) {
+    std::vector<uint8_t> bytes(c.getEncodedSize() + transport::kAuthTrailerBytes);
+    const int size = c.encode(bytes.data(), 0, c.getEncodedSize());
+    other.seal(transport::kRolloutChannel, bytes.data(), size, bytes.data() + size);
+    learner.transport().publishWire(transport::kRolloutChannel, bytes.data(), static_cast<int>(bytes.size()));
+  }
+  const int forged = static_cast<int>(chunks.size());
+  EXPECT_FALSE(stepUntilUpdate(learner, 50));
+  EXPECT_EQ(learner.version(), 0);
+  EXPECT_EQ(learner.dropStats()[transport::DropReason::kUnauthenticated], forged);
+  EXPECT_EQ(learner.dropStats()[transport::DropReason::kAccepted], 0);
+
+  // The same rollout, same numbering, signed with the run key: the forged copies left no trace.
+  actor.send(learner.transport(), 8, 0, 0);
+  ASSERT_TRUE(stepUntilUpdate(learner));
+  EXPECT_EQ(learner.version(), 1);
+  EXPECT_EQ(learner.dropStats()[transport::DropReason::kDuplicate], 0);
+  EXPECT_EQ(learner.droppedChunks(), forged);
+  int64_t reported = -1;
+  for (int i = 0; i < stats.num_drop_reasons; ++i)
+    if (stats.drop_reason_names[i] == "unauthenticated") reported = stats.drop_counts[i];
+  EXPECT_EQ(reported, forged) << "the stats message carries the count under its own reason";
   fs::remove_all(dir);
 }
 

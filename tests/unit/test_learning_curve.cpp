@@ -9,18 +9,14 @@
 #include <unistd.h>
 
 #include "learner/learning_curve.hpp"
+#include "test_temp_dir.hpp"
 
 namespace masa::learner {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path freshDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("masa_test_curve_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path freshDir(const std::string& name) { return masa::testing::freshTempDir("masa_test_curve_" + name); }
 
 // A metrics.csv as the learner writes it, with one update in which no episode ended (nan) and an
 // evaluation of the policy mean every other update (nan between).

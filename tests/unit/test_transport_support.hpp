@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/transport/actor_rollout.hpp"
+#include "masa/lcmt_policy_params.hpp"
 
 namespace masa::transport::testing {
 
@@ -50,6 +51,22 @@ inline void fillRandomRollout(ActorRollout& r, const RolloutShape& s, uint64_t s
       r.addEpisode(e, normal(rng), 1 + static_cast<int>(uniform(rng) * 500), success, terms);
     }
   }
+}
+
+// A small, valid parameter broadcast: 40 parameters and a 6-dimensional normalizer.
+inline masa::lcmt_policy_params samplePolicy() {
+  masa::lcmt_policy_params p{};
+  p.run_id = 42;
+  p.utime = 1'700'000'000'000'000;
+  p.version = 17;
+  p.method = "masa";
+  p.task = "a1_beam";
+  p.num_params = 40;
+  for (int i = 0; i < p.num_params; ++i) p.params.push_back(0.01f * static_cast<float>(i) - 0.2f);
+  p.obs_dim = 6;
+  p.obs_mean.assign(6, 0.5f);
+  p.obs_std.assign(6, 2.0f);
+  return p;
 }
 
 template <class Msg>
