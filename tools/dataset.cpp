@@ -25,6 +25,7 @@
 #include "common/policy/policy_file.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/lcm_url.hpp"
+#include "common/transport/transport.hpp"
 
 using namespace masa;
 namespace fs = std::filesystem;
@@ -46,9 +47,6 @@ struct Recording {
   int64_t episodes = 0, transitions = 0;
   double seconds = 0;
   task::EvalSummary summary;
-  static int64_t utime() {
-    return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-  }
 };
 
 // Records `episodes` episodes of one policy into `writer` (and onto LCM when `lcm` is given).
@@ -68,7 +66,7 @@ Recording recordPolicy(const std::string& policy_file, const std::string& name, 
   r.summary = dataset::recordEpisodes(factory, *p.model, o, [&](const dataset::EpisodeRecord& e) {
     writer.write(e);
     if (lcm)  // 128 steps a message: about 30 KB, well under LCM's fragmenting size
-      for (masa::lcmt_transitions& m : dataset::episodeMessages(e, 128, r.utime())) lcm->publish(transport::kDatasetChannel, &m);
+      for (masa::lcmt_transitions& m : dataset::episodeMessages(e, 128, transport::wallClockMicros())) lcm->publish(transport::kDatasetChannel, &m);
     ++r.episodes;
     r.transitions += e.length();
   });

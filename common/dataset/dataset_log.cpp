@@ -2,7 +2,6 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +11,7 @@
 #include <unordered_set>
 
 #include "common/transport/channels.hpp"
+#include "common/transport/transport.hpp"
 #include "common/transport/wire_guard.hpp"
 
 namespace masa::dataset {
@@ -20,11 +20,6 @@ namespace {
 constexpr uint32_t kLogSync = 0xEDA1DA01u;  // LCM log event marker (lcm/eventlog.c)
 constexpr int32_t kMaxChannelBytes = 256;    // LCM's own channel name limit is 63
 constexpr int32_t kMaxEventBytes = 1 << 30;
-
-int64_t nowMicros() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 uint64_t bigEndian(const unsigned char* p, int n) {
   uint64_t v = 0;
@@ -255,7 +250,7 @@ DatasetLogWriter::~DatasetLogWriter() = default;
 
 void DatasetLogWriter::write(const EpisodeRecord& episode) {
   std::vector<unsigned char> bytes;
-  for (masa::lcmt_transitions& m : episodeMessages(episode, max_steps_, nowMicros())) {
+  for (masa::lcmt_transitions& m : episodeMessages(episode, max_steps_, transport::wallClockMicros())) {
     bytes.resize(static_cast<size_t>(m.getEncodedSize()));
     m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
     lcm::LogEvent ev;
