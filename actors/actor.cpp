@@ -220,7 +220,7 @@ bool Actor::collectAndPublish() {
   const int E = num_envs_;
   rollout_.clearEvents();
   model_->logStd(log_std_);
-  std::copy(log_std_.data(), log_std_.data() + act_dim_, rollout_.log_std.begin());
+  rollout_.setLogStd(log_std_.data());
 
   for (int e = 0; e < E; ++e) envs_[e]->observe(rollout_.obsAt(0, e));
   const int threads = std::min(options_.threads, E);
@@ -233,8 +233,8 @@ bool Actor::collectAndPublish() {
     });
     float* log_prob = rollout_.log_prob.data() + rollout_.step(t, 0);
     float* reward = rollout_.reward.data() + rollout_.step(t, 0);
-    int8_t* term = rollout_.terminated.data() + rollout_.step(t, 0);
-    int8_t* trunc = rollout_.truncated.data() + rollout_.step(t, 0);
+    uint8_t* term = rollout_.terminated.data() + rollout_.step(t, 0);
+    uint8_t* trunc = rollout_.truncated.data() + rollout_.step(t, 0);
 
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int e = 0; e < E; ++e) {
@@ -262,7 +262,7 @@ bool Actor::collectAndPublish() {
       }
       env.observe(rollout_.obsAt(t + 1, e));
     }
-    // Events in ascending (t, e) order, as ActorRollout requires.
+    // Events in ascending (t, e) order, as Rollout requires.
     for (int e = 0; e < E; ++e) {
       if (!done_[e]) continue;
       if (trunc[e]) rollout_.addFinal(t, e, final_obs_.data() + static_cast<std::size_t>(e) * obs_dim_);
@@ -276,7 +276,7 @@ bool Actor::collectAndPublish() {
     if (stopRequested()) return false;
   }
 
-  transport::RolloutIdentity id;
+  RolloutIdentity id;
   id.run_id = options_.run_id;
   id.actor_id = options_.actor_id;
   id.rollout_seq = first_rollout_seq_ + rollouts_sent_;

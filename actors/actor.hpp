@@ -22,8 +22,8 @@
 #include "common/model/actor_critic.hpp"
 #include "common/task/registry.hpp"
 #include "actors/await_budget.hpp"
-#include "common/transport/actor_rollout.hpp"
-#include "common/transport/rollout_chunker.hpp"
+#include "common/rollout/rollout.hpp"
+#include "actors/rollout_chunker.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
@@ -44,7 +44,7 @@ struct ActorOptions {
   int threads = 1;               // OpenMP threads over environments
   bool start_without_learner = false;  // act with own initial parameters as version 0
   double heartbeat_interval_s = 1.0;
-  int chunk_bytes = transport::kDefaultChunkBytes;
+  int chunk_bytes = kDefaultChunkBytes;
   // rollout_seq of the first rollout, +1 per rollout after it. kRolloutSeqFromClock: the wall clock
   // in microseconds when the actor is made, so that an actor restarted with the same id numbers
   // its rollouts far past its previous process's (the learner's duplicate filter would otherwise
@@ -106,7 +106,7 @@ class Actor {
   int64_t chunksPublished() const { return chunks_published_; }
   int64_t chunksDropped() const { return chunks_dropped_; }  // by drop_chunks_percent
   int64_t paramsRejected() const { return params_rejected_; }
-  const transport::ActorRollout& lastRollout() const { return rollout_; }
+  const rollout::Rollout& lastRollout() const { return rollout_; }
   int numEnvs() const { return num_envs_; }
   model::ActorCritic<float>& model() { return *model_; }
   void publishHeartbeat();
@@ -133,8 +133,8 @@ class Actor {
   std::vector<Rng> rngs_;
   std::unique_ptr<model::ActorCritic<float>> model_;
   int policy_param_count_ = 0;  // the policy + log-std prefix of the flat parameters
-  transport::ActorRollout rollout_;
-  transport::RolloutChunker chunker_;
+  rollout::Rollout rollout_;
+  RolloutChunker chunker_;
   int obs_dim_, act_dim_, num_terms_;
 
   // Per-environment scratch of one step, filled in parallel and recorded in env order after it.

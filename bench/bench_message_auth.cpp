@@ -19,10 +19,10 @@
 #include "common/model/actor_critic.hpp"
 #include "common/model/method.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
-#include "common/transport/actor_rollout.hpp"
+#include "common/rollout/rollout.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/message_auth.hpp"
-#include "common/transport/rollout_chunker.hpp"
+#include "actors/rollout_chunker.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
 namespace {
@@ -39,11 +39,11 @@ std::vector<uint8_t> encoded(const Msg& m) {
 
 // The first chunk of an a1_beam rollout of 32 environments x 32 steps: a full 60 KB one.
 std::vector<uint8_t> rolloutChunk() {
-  transport::ActorRollout r;
+  rollout::Rollout r;
   r.allocate(32, 32, 47, 12, {"velocity", "alive"});
   r.clearEvents();
   for (std::size_t i = 0; i < r.obs.size(); ++i) r.obs[i] = std::sin(static_cast<float>(i));
-  transport::RolloutChunker chunker;
+  actor::RolloutChunker chunker;
   const auto chunks = chunker.split(r, {1, 0, 0, 0});
   return encoded(chunks[0]);
 }

@@ -24,10 +24,11 @@
 #include "common/model/actor_critic.hpp"
 #include "common/nn/adam.hpp"
 #include "common/task/registry.hpp"
-#include "common/transport/batch_collector.hpp"
-#include "common/transport/rollout_assembler.hpp"
 #include "common/transport/transport.hpp"
+#include "learner/intake/batch_collector.hpp"
+#include "learner/intake/rollout_assembler.hpp"
 #include "learner/learning_curve.hpp"
+#include "learner/update_report.hpp"
 #include "learner/ppo/ppo_trainer.hpp"
 #include "learner/ppo/rollout_buffer.hpp"
 #include "learner/silence_watch.hpp"
@@ -43,21 +44,6 @@ struct LearnerOptions {
   // or in-process memq runs).
   std::optional<transport::RunKey> run_key;
   bool verbose = true;  // one progress line per update on stdout
-};
-
-// Summary of the last update (also what the stats message carries).
-struct UpdateReport {
-  int64_t epoch = 0, version = 0, env_steps = 0;
-  double wall_time_s = 0, fps = 0;
-  int num_episodes = 0;
-  double mean_return = 0, mean_length = 0, success_rate = -1;
-  std::vector<double> term_means;
-  ppo::PpoStats ppo;
-  int64_t dropped_chunks = 0;  // by the assembler, every reason (lost included), since the run began
-  int64_t dropped_envs = 0;    // by the collector (stale, overflow), since the run began
-  // The policy mean's evaluation (runner.eval_every): NaN in updates without one.
-  double eval_return = std::nan(""), eval_length = std::nan(""), eval_success = std::nan("");
-  std::vector<double> eval_progress;  // the task's progress figures (Task::progressNames)
 };
 
 class Learner {
@@ -85,13 +71,15 @@ class Learner {
 
   transport::Transport& transport() { return *transport_; }
   int64_t runId() const { return run_id_; }
-  int64_t version() const { return version_; }
-  int64_t epoch() const { return epoch_; }
+  // Updates done (resumed ones included). The policy version is the same count: the number of
+  // updates the broadcast parameters have seen (update_report.hpp says how updates are counted).
+  int64_t updates() const { return updates_; }
+  int64_t version() const { return updates_; }
   int64_t envSteps() const { return env_steps_; }
   const std::string& runDir() const { return dir_; }
   const model::ActorCritic<float>& model() const { return *model_; }
   // The assembler's counts, and the chunks the transport dropped for want of a valid tag.
-  transport::DropStats dropStats() const;
+  DropStats dropStats() const;
   // One unit each: rollout chunks the assembler dropped (or counted lost), and environments the
   // collector dropped (stale or overflowing its pool).
   int64_t droppedChunks() const;
@@ -100,11 +88,9 @@ class Learner {
 
  private:
   void onChunk(const void* data, int size);
-  void update(const transport::RolloutBatch& batch);
-  void fillBuffer(const transport::RolloutBatch& batch);
-  void summarizeEpisodes(const transport::ActorRollout& d);
-  void publishStats();
-  void appendCsv();
+  void update();
+  // Tells the update: the stats message, metrics.csv, the curve, the progress line.
+  void report();
   void loadCheckpoint();
   void evaluate();
   double wallTime() const;
@@ -121,13 +107,12 @@ class Learner {
   std::unique_ptr<ppo::RolloutBuffer> buffer_;
 
   std::unique_ptr<transport::Transport> transport_;
-  std::unique_ptr<transport::RolloutAssembler> assembler_;  // made once the run id is known
+  std::unique_ptr<RolloutAssembler> assembler_;  // made once the run id is known
   std::unique_ptr<SilenceWatch> silence_;
   // Made on the first accepted chunk: the reward term names come from the actors' task.
-  std::unique_ptr<transport::BatchCollector> collector_;
-  transport::RolloutBatch batch_;
+  std::unique_ptr<BatchCollector> collector_;
 
-  int64_t version_ = 0, epoch_ = 0, env_steps_ = 0;
+  int64_t updates_ = 0, env_steps_ = 0;
   double wall_offset_s_ = 0;  // wall time of the runs before a resume
   std::chrono::steady_clock::time_point start_, last_update_, last_publish_;
   std::vector<int> restored_order_;  // shuffle permutation from a checkpoint, used once
@@ -137,7 +122,7 @@ class Learner {
   UpdateReport report_;
   // The task, built once, for the evaluations of runner.eval_every (null when they are off).
   std::unique_ptr<task::TaskFactory> eval_factory_;
-  std::vector<std::string> eval_progress_names_;
+  ReportColumns columns_;  // reward terms (from the first chunk) and the task's progress figures
 };
 
 }  // namespace masa::learner

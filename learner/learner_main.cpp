@@ -16,7 +16,7 @@
 
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
-#include "common/transport/drop_reason.hpp"
+#include "learner/intake/drop_reason.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/run_key.hpp"
 #include "learner/learner.hpp"
@@ -98,13 +98,13 @@ int main(int argc, char** argv) {
               << learner.version() << ", url '" << url << "'" << std::endl;
     // run() finishes the step in progress when a signal arrives, then checkpoints.
     learner.run(max_updates, &g_stop);
-    std::cout << "masa_learner: stopped after " << learner.epoch() << " updates; checkpoint written" << std::endl;
+    std::cout << "masa_learner: stopped after " << learner.updates() << " updates; checkpoint written" << std::endl;
     // What became of the actors' rollout chunks, by reason (lost: never arrived).
     const auto& drops = learner.dropStats();
-    std::cout << "masa_learner: rollout chunks accepted " << drops[masa::transport::DropReason::kAccepted];
-    for (int r = 1; r < masa::transport::kNumDropReasons; ++r) {
-      const auto reason = static_cast<masa::transport::DropReason>(r);
-      if (drops[reason] > 0) std::cout << ", " << masa::transport::dropReasonName(reason) << " " << drops[reason];
+    std::cout << "masa_learner: rollout chunks accepted " << drops[masa::learner::DropReason::kAccepted];
+    for (int r = 1; r < masa::learner::kNumDropReasons; ++r) {
+      const auto reason = static_cast<masa::learner::DropReason>(r);
+      if (drops[reason] > 0) std::cout << ", " << masa::learner::dropReasonName(reason) << " " << drops[reason];
     }
     std::cout << std::endl;
   } catch (const std::exception& e) {

@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
                  rc.task.c_str(), masa::model::methodName(rc.method).c_str(), rc.ppo.num_envs, rc.ppo.horizon,
                  static_cast<long long>(updates), learner.runDir().c_str());
 
-    while (!g_stop.load() && learner.epoch() < updates) {
+    while (!g_stop.load() && learner.updates() < updates) {
       if (!actor.pollParams(0)) {
         learner.publishParams();  // the first broadcast may predate the actor's subscription
         if (!actor.pollParams(0)) throw std::runtime_error("the actor received no parameters from the learner");
@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
     learner.writeCheckpoint();
     learner.renderLearningCurve();
     std::fprintf(stderr, "masa_train: %lld updates, %lld env steps; run dir %s\n",
-                 static_cast<long long>(learner.epoch()), static_cast<long long>(learner.envSteps()),
+                 static_cast<long long>(learner.updates()), static_cast<long long>(learner.envSteps()),
                  learner.runDir().c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_train: %s\n", e.what());

@@ -161,23 +161,25 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
   model::ActorCritic<float>& model = *model_;
   auto& params = model.params();
   const int m = config_.minibatch_size;
-  const int per_epoch = batch_size_ / m;
+  const int minibatches_per_mini_epoch = batch_size_ / m;
   const float max_norm = static_cast<float>(config_.grad_norm);
-  const Mat<float>& obs = buffer.obs();
-  const Mat<float>& actions = buffer.actions();
-  const Mat<float>& log_probs = buffer.logProbs();
+  const auto obs = buffer.obs();
+  const auto actions = buffer.actions();
+  const auto log_probs = buffer.logProbs();
   PpoStats st = prepared_;
   // The KL that drives the learning rate compares each minibatch with the policy of its previous
   // visit (rl_games' update_mu_sigma): it starts at the collection policy and is overwritten after
   // every minibatch. The ratio of the surrogate keeps the collection log-probabilities.
   kl_ref_mean_ = buffer.means();
-  kl_ref_log_std_ = buffer.logStds();
+  const auto env_log_std = buffer.envLogStds();  // the same for all steps of an environment
+  kl_ref_log_std_.resize(buffer.actDim(), buffer.size());
+  for (int c = 0; c < buffer.size(); ++c) kl_ref_log_std_.col(c) = env_log_std.col(c % buffer.numEnvs());
 
-  for (int epoch = 0; epoch < config_.mini_epochs; ++epoch) {
+  for (int mini_epoch = 0; mini_epoch < config_.mini_epochs; ++mini_epoch) {
     // Fisher-Yates with the raw engine output: the same permutation on every standard library.
     for (int i = batch_size_ - 1; i > 0; --i) std::swap(order_[i], order_[static_cast<int>(rng() % (i + 1))]);
 
-    for (int k = 0; k < per_epoch; ++k) {
+    for (int k = 0; k < minibatches_per_mini_epoch; ++k) {
       const int* idx = order_.data() + static_cast<std::ptrdiff_t>(k) * m;
       for (int j = 0; j < m; ++j) {
         const int c = idx[j];

@@ -1,60 +1,42 @@
 #include "learner/ppo/rollout_buffer.hpp"
 
-#include <algorithm>
-
 #include "common/core/check.hpp"
 
 namespace masa::ppo {
 
-RolloutBuffer::RolloutBuffer(int num_envs, int horizon, int obs_dim, int act_dim)
-    : num_envs_(num_envs), horizon_(horizon), obs_dim_(obs_dim), act_dim_(act_dim) {
+RolloutBuffer::RolloutBuffer(int num_envs, int horizon, int obs_dim, int act_dim) {
   MASA_CHECK(num_envs > 0 && horizon > 0 && obs_dim > 0 && act_dim > 0,
              "rollout buffer needs positive sizes, got envs " << num_envs << ", horizon " << horizon << ", obs "
                                                               << obs_dim << ", act " << act_dim);
-  const Eigen::Index n = static_cast<Eigen::Index>(num_envs) * horizon;
-  obs_ = Mat<Scalar>::Zero(obs_dim, n);
-  actions_ = Mat<Scalar>::Zero(act_dim, n);
-  means_ = Mat<Scalar>::Zero(act_dim, n);
-  log_probs_ = Mat<Scalar>::Zero(1, n);
-  log_stds_ = Mat<Scalar>::Zero(act_dim, n);
-  rewards_ = StepMat<Scalar>::Zero(horizon, num_envs);
-  terminated_ = FlagMat::Zero(horizon, num_envs);
-  truncated_ = FlagMat::Zero(horizon, num_envs);
-  bootstrap_obs_ = Mat<Scalar>::Zero(obs_dim, num_envs);
-  // Room for one time-out per env and batch; more grows the storage.
-  final_entries_.resize(num_envs);
-  final_obs_ = Mat<Scalar>::Zero(obs_dim, num_envs);
+  data_.allocate(num_envs, horizon, obs_dim, act_dim);
   values_ = StepMat<Scalar>::Zero(horizon, num_envs);
   advantages_ = StepMat<Scalar>::Zero(horizon, num_envs);
   returns_ = StepMat<Scalar>::Zero(horizon, num_envs);
 }
 
 void RolloutBuffer::addFinalObs(int t, int e, const ConstMatRef<Scalar>& obs_column) {
-  MASA_CHECK(t >= 0 && t < horizon_ && e >= 0 && e < num_envs_, "final obs at (" << t << ", " << e << ") is outside "
-                                                                                  << horizon_ << " x " << num_envs_);
-  MASA_CHECK(obs_column.rows() == obs_dim_ && obs_column.cols() == 1,
-             "final obs is " << obs_column.rows() << "x" << obs_column.cols() << ", expected " << obs_dim_ << "x1");
-  if (num_final_ == final_obs_.cols()) {
-    const Eigen::Index cap = std::max<Eigen::Index>(1, 2 * final_obs_.cols());
-    final_obs_.conservativeResize(Eigen::NoChange, cap);
-    final_entries_.resize(cap);
-  }
-  final_entries_[num_final_] = {t, e};
-  final_obs_.col(num_final_) = obs_column;
-  ++num_final_;
+  MASA_CHECK(obs_column.rows() == obsDim() && obs_column.cols() == 1,
+             "final obs is " << obs_column.rows() << "x" << obs_column.cols() << ", expected " << obsDim() << "x1");
+  const Vec<Scalar> column = obs_column;  // contiguous, whatever the caller's stride
+  data_.addFinal(t, e, column.data());
 }
 
 void RolloutBuffer::checkFinalObs() const {
-  FlagMat seen = FlagMat::Zero(horizon_, num_envs_);
-  for (int k = 0; k < num_final_; ++k) {
-    const auto [t, e] = final_entries_[k];
-    MASA_CHECK(truncated_(t, e), "final obs recorded at (" << t << ", " << e << "), which is not truncated");
-    MASA_CHECK(!seen(t, e), "two final obs recorded at (" << t << ", " << e << ")");
-    seen(t, e) = 1;
+  const int E = numEnvs();
+  MASA_CHECK(data_.final_obs.size() == data_.final_index.size() * static_cast<std::size_t>(obsDim()),
+             "final_obs holds " << data_.final_obs.size() << " floats for " << data_.final_index.size() << " truncations");
+  int previous = -1;
+  for (int k = 0; k < numFinalObs(); ++k) {
+    const int idx = data_.final_index[k];
+    MASA_CHECK(idx >= 0 && idx < size(), "final obs at step index " << idx << " is outside " << horizon() << " x " << E);
+    MASA_CHECK(idx > previous, "final obs at (" << idx / E << ", " << idx % E << ") repeated or out of order");
+    MASA_CHECK(data_.truncated[idx], "final obs recorded at (" << idx / E << ", " << idx % E << "), which is not truncated");
+    previous = idx;
   }
-  for (int t = 0; t < horizon_; ++t)
-    for (int e = 0; e < num_envs_; ++e)
-      MASA_CHECK(!truncated_(t, e) || seen(t, e), "truncated step (" << t << ", " << e << ") has no final obs");
+  int truncations = 0;
+  for (uint8_t f : data_.truncated) truncations += f != 0;
+  MASA_CHECK(truncations == numFinalObs(),
+             truncations << " truncated steps but " << numFinalObs() << " final observations: a truncated step has none");
 }
 
 }  // namespace masa::ppo

@@ -1,15 +1,18 @@
 // One batch of trajectories from num_envs environments over `horizon` steps, allocated once.
 //
-// Step t of env e is column t*E + e of every per-sample matrix (obs, actions, means, log-probs),
-// and entry (t, e) of every per-step T x E matrix, which is row-major so that its data has that
-// same order. Time-outs (truncated) are kept apart from terminations: a truncated step carries the
-// observation the environment reached before it was reset, for the value bootstrap.
+// The samples are a rollout::Rollout (common/rollout/rollout.hpp), the layout every stage from the
+// actor on uses; this class adds Eigen views over it and what the update computes from it. Step t
+// of env e is column t*E + e of every per-sample matrix (obs, actions, means, log-probs), and entry
+// (t, e) of every per-step T x E matrix, which is row-major so that its data has that same order.
+// Time-outs (truncated) are kept apart from terminations: a truncated step carries the observation
+// the environment reached before it was reset, for the value bootstrap.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "common/rollout/rollout.hpp"
 
 namespace masa::ppo {
 
@@ -17,7 +20,7 @@ template <typename S>
 using StepMat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;  // T x E
 using FlagMat = StepMat<std::uint8_t>;
 
-// A truncated step (t, e) and the column of its pre-reset observation in finalObs().
+// A truncated step (t, e); its pre-reset observation is the same column of finalObs().
 struct FinalObsEntry {
   int t = 0;
   int e = 0;
@@ -26,46 +29,59 @@ struct FinalObsEntry {
 class RolloutBuffer {
  public:
   using Scalar = float;
+  using SampleMap = Eigen::Map<Mat<Scalar>>;
+  using ConstSampleMap = Eigen::Map<const Mat<Scalar>>;
+  using StepMap = Eigen::Map<StepMat<Scalar>>;
+  using ConstStepMap = Eigen::Map<const StepMat<Scalar>>;
+  using FlagMap = Eigen::Map<FlagMat>;
+  using ConstFlagMap = Eigen::Map<const FlagMat>;
 
   RolloutBuffer(int num_envs, int horizon, int obs_dim, int act_dim);
 
-  int numEnvs() const { return num_envs_; }
-  int horizon() const { return horizon_; }
-  int obsDim() const { return obs_dim_; }
-  int actDim() const { return act_dim_; }
-  int size() const { return num_envs_ * horizon_; }  // T * E samples
-  int column(int t, int e) const { return t * num_envs_ + e; }
+  int numEnvs() const { return data_.num_envs; }
+  int horizon() const { return data_.horizon; }
+  int obsDim() const { return data_.obs_dim; }
+  int actDim() const { return data_.act_dim; }
+  int size() const { return data_.numSteps(); }  // T * E samples
+  int column(int t, int e) const { return t * data_.num_envs + e; }
 
-  // Forgets the time-outs of the last batch; everything else is overwritten by the next one.
-  void clear() { num_final_ = 0; }
+  // The samples, filled in place by the learner's intake (BatchCollector::take) or by a test.
+  rollout::Rollout& data() { return data_; }
+  const rollout::Rollout& data() const { return data_; }
 
-  // Filled by the collector.
-  Mat<Scalar>& obs() { return obs_; }                    // obs_dim x T*E
-  Mat<Scalar>& actions() { return actions_; }            // act_dim x T*E
-  Mat<Scalar>& means() { return means_; }                // act_dim x T*E, behaviour policy means
-  Mat<Scalar>& logProbs() { return log_probs_; }         // 1 x T*E, behaviour log-probs
-  // act_dim x T*E, behaviour log-std of each sample: with max_policy_lag > 0 one batch mixes
-  // rollouts of several policy versions, each with its own state-independent std.
-  Mat<Scalar>& logStds() { return log_stds_; }
-  StepMat<Scalar>& rewards() { return rewards_; }        // T x E
-  FlagMat& terminated() { return terminated_; }          // T x E, 1 where the episode ended for good
-  FlagMat& truncated() { return truncated_; }            // T x E, 1 where it hit the time limit
-  Mat<Scalar>& bootstrapObs() { return bootstrap_obs_; }  // obs_dim x E, observation after step T-1
-  // Records the pre-reset observation of a time-out at (t, e) (grows storage only when needed).
+  // Forgets the time-outs and episodes of the last batch; everything else is overwritten by the next.
+  void clear() { data_.clearEvents(); }
+
+  // Views over data().
+  SampleMap obs() { return SampleMap(data_.obs.data(), obsDim(), size()); }             // obs_dim x T*E
+  SampleMap actions() { return SampleMap(data_.actions.data(), actDim(), size()); }     // act_dim x T*E
+  SampleMap means() { return SampleMap(data_.mean.data(), actDim(), size()); }          // behaviour means
+  SampleMap logProbs() { return SampleMap(data_.log_prob.data(), 1, size()); }          // 1 x T*E
+  // act_dim x E: each environment's behaviour log std (a batch may mix policy versions).
+  SampleMap envLogStds() { return SampleMap(data_.env_log_std.data(), actDim(), numEnvs()); }
+  StepMap rewards() { return StepMap(data_.reward.data(), horizon(), numEnvs()); }       // T x E
+  FlagMap terminated() { return FlagMap(data_.terminated.data(), horizon(), numEnvs()); }  // ended for good
+  FlagMap truncated() { return FlagMap(data_.truncated.data(), horizon(), numEnvs()); }    // hit the time limit
+  // obs_dim x E, the observation after step T-1 (row T of the rollout's observations).
+  SampleMap bootstrapObs() { return SampleMap(data_.obsAt(horizon(), 0), obsDim(), numEnvs()); }
+  // Records the pre-reset observation of a time-out at (t, e); in ascending (t, e) order.
   void addFinalObs(int t, int e, const ConstMatRef<Scalar>& obs_column);
 
-  const Mat<Scalar>& obs() const { return obs_; }
-  const Mat<Scalar>& actions() const { return actions_; }
-  const Mat<Scalar>& means() const { return means_; }
-  const Mat<Scalar>& logProbs() const { return log_probs_; }
-  const Mat<Scalar>& logStds() const { return log_stds_; }
-  const StepMat<Scalar>& rewards() const { return rewards_; }
-  const FlagMat& terminated() const { return terminated_; }
-  const FlagMat& truncated() const { return truncated_; }
-  const Mat<Scalar>& bootstrapObs() const { return bootstrap_obs_; }
-  int numFinalObs() const { return num_final_; }
-  const FinalObsEntry& finalObsEntry(int k) const { return final_entries_[k]; }
-  auto finalObs() const { return final_obs_.leftCols(num_final_); }  // obs_dim x numFinalObs()
+  ConstSampleMap obs() const { return ConstSampleMap(data_.obs.data(), obsDim(), size()); }
+  ConstSampleMap actions() const { return ConstSampleMap(data_.actions.data(), actDim(), size()); }
+  ConstSampleMap means() const { return ConstSampleMap(data_.mean.data(), actDim(), size()); }
+  ConstSampleMap logProbs() const { return ConstSampleMap(data_.log_prob.data(), 1, size()); }
+  ConstSampleMap envLogStds() const { return ConstSampleMap(data_.env_log_std.data(), actDim(), numEnvs()); }
+  ConstStepMap rewards() const { return ConstStepMap(data_.reward.data(), horizon(), numEnvs()); }
+  ConstFlagMap terminated() const { return ConstFlagMap(data_.terminated.data(), horizon(), numEnvs()); }
+  ConstFlagMap truncated() const { return ConstFlagMap(data_.truncated.data(), horizon(), numEnvs()); }
+  ConstSampleMap bootstrapObs() const { return ConstSampleMap(data_.obsAt(horizon(), 0), obsDim(), numEnvs()); }
+  int numFinalObs() const { return data_.numFinal(); }
+  FinalObsEntry finalObsEntry(int k) const {
+    const int idx = data_.final_index[k];
+    return {idx / numEnvs(), idx % numEnvs()};
+  }
+  ConstSampleMap finalObs() const { return ConstSampleMap(data_.final_obs.data(), obsDim(), numFinalObs()); }
 
   // Throws unless every truncated step has exactly one final observation and vice versa.
   void checkFinalObs() const;
@@ -79,14 +95,7 @@ class RolloutBuffer {
   const StepMat<Scalar>& returns() const { return returns_; }
 
  private:
-  int num_envs_, horizon_, obs_dim_, act_dim_;
-  Mat<Scalar> obs_, actions_, means_, log_probs_, log_stds_;
-  StepMat<Scalar> rewards_;
-  FlagMat terminated_, truncated_;
-  Mat<Scalar> bootstrap_obs_;
-  std::vector<FinalObsEntry> final_entries_;
-  Mat<Scalar> final_obs_;  // obs_dim x capacity; the first num_final_ columns are in use
-  int num_final_ = 0;
+  rollout::Rollout data_;
   StepMat<Scalar> values_, advantages_, returns_;
 };
 

@@ -18,7 +18,7 @@
 #include "common/config/run_config.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
-#include "common/transport/rollout_assembler.hpp"
+#include "learner/intake/rollout_assembler.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 #include "masa/lcmt_policy_params.hpp"
@@ -72,8 +72,8 @@ struct FakeLearner {
 };
 
 // The learner's chunk gate, configured for this test run's dimensions (warnings off).
-transport::AssemblerConfig assemblerConfigFor(const FakeLearner& learner) {
-  transport::AssemblerConfig ac;
+learner::AssemblerConfig assemblerConfigFor(const FakeLearner& learner) {
+  learner::AssemblerConfig ac;
   ac.run_id = kRunId;
   ac.horizon = kHorizon;
   ac.obs_dim = learner.spec.obsDim();
@@ -125,7 +125,7 @@ TEST(ActorRollouts, ChunksFromLearnerParamsPassTheAssemblerWithAllEnvsAndEpisode
   bus.drain();
   ASSERT_EQ(actor.paramsRejected(), 0);
 
-  transport::RolloutAssembler assembler(assemblerConfigFor(learner));
+  learner::RolloutAssembler assembler(assemblerConfigFor(learner));
   assembler.setLearnerVersion(1);
   ASSERT_GE(cap.chunks.size(), 4u) << "expected each rollout split into at least two chunks";
   std::vector<std::set<int>> envs_seen(2);
@@ -350,11 +350,11 @@ TEST(ActorRollouts, ARestartedActorNumbersItsRolloutsPastItsPreviousProcessAndIs
     bus.drain();
   }
   EXPECT_GT(first_seq[1], first_seq[0] + 2) << "the restart numbers past every rollout the first process sent";
-  transport::RolloutAssembler assembler(assemblerConfigFor(learner));
+  learner::RolloutAssembler assembler(assemblerConfigFor(learner));
   assembler.setLearnerVersion(1);
   for (const auto& bytes : cap.chunks) {
     const auto v = assembler.acceptEncoded(bytes.data(), static_cast<int>(bytes.size()));
-    EXPECT_TRUE(v) << "dropped: " << transport::dropReasonName(v.reason);
+    EXPECT_TRUE(v) << "dropped: " << learner::dropReasonName(v.reason);
   }
   EXPECT_EQ(assembler.actorTally(3).accepted, static_cast<int64_t>(cap.chunks.size()));
   EXPECT_EQ(assembler.actorTally(3).numberings, 2);

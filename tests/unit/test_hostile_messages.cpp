@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/transport/channels.hpp"
-#include "common/transport/rollout_chunker.hpp"
+#include "actors/rollout_chunker.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 #include "masa/lcmt_learner_stats.hpp"
@@ -21,6 +21,10 @@
 
 namespace masa::transport {
 namespace {
+
+// The actors' chunking and the learner's intake, tested against each other and the wire.
+using namespace masa::actor;
+using namespace masa::learner;
 
 using testing::encode;
 using testing::samplePolicy;
@@ -58,7 +62,7 @@ masa::lcmt_learner_stats sampleStats() {
 
 // A small real chunk, with truncations, episodes and term names (every array non-empty).
 masa::lcmt_rollout_chunk sampleChunk() {
-  ActorRollout r;
+  rollout::Rollout r;
   testing::fillRandomRollout(r, testing::RolloutShape{3, 4, 5, 2}, 9, 0.3);
   RolloutChunker chunker(1 << 20);
   const auto chunks = chunker.split(r, RolloutIdentity{.run_id = 42, .actor_id = 1, .rollout_seq = 5, .policy_version = 17});

@@ -17,7 +17,7 @@
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/message_auth.hpp"
-#include "common/transport/rollout_chunker.hpp"
+#include "actors/rollout_chunker.hpp"
 #include "learner/learner.hpp"
 #include "masa/lcmt_learner_stats.hpp"
 #include "masa/lcmt_policy_params.hpp"
@@ -50,8 +50,8 @@ LearnerOptions options(const fs::path& dir, int64_t run_id) {
 
 // A fake actor: a consistent Gaussian policy (mean 0, log std 0) with one time-out and one episode.
 struct FakeActor {
-  transport::ActorRollout rollout;
-  transport::RolloutChunker chunker;
+  rollout::Rollout rollout;
+  actor::RolloutChunker chunker;
 
   FakeActor(const config::RunConfig& rc, uint64_t seed) {
     const auto spec = sym::SymmetrySpec::load(rc.spec_path);
@@ -63,7 +63,7 @@ struct FakeActor {
     for (float& x : rollout.obs) x = normal(rng);
     for (float& x : rollout.reward) x = normal(rng);
     for (float& x : rollout.mean) x = 0.0f;
-    for (float& x : rollout.log_std) x = 0.0f;
+    for (float& x : rollout.env_log_std) x = 0.0f;
     for (int t = 0; t < T; ++t) {
       for (int e = 0; e < E; ++e) {
         double lp = 0;
@@ -124,7 +124,7 @@ TEST(LearnerNode, OneBatchFromAFakeActorMakesVersionOneAndPublishesParamsStatsAn
   ASSERT_TRUE(stepUntilUpdate(learner));
 
   EXPECT_EQ(learner.version(), 1);
-  EXPECT_EQ(learner.epoch(), 1);
+  EXPECT_EQ(learner.updates(), 1);
   EXPECT_EQ(learner.envSteps(), 8 * 4);
   EXPECT_EQ(params.version, 1);
   EXPECT_EQ(params.run_id, 77);
@@ -176,9 +176,9 @@ TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTri
   const int nan_chunks = poisoned.send(learner.transport(), 5, 0, 0);
   EXPECT_FALSE(stepUntilUpdate(learner, 50));
   EXPECT_EQ(learner.version(), 0);
-  EXPECT_EQ(learner.dropStats()[transport::DropReason::kWrongRun], foreign);
-  EXPECT_EQ(learner.dropStats()[transport::DropReason::kMalformed], 1);
-  EXPECT_EQ(learner.dropStats()[transport::DropReason::kNonFinite], nan_chunks);
+  EXPECT_EQ(learner.dropStats()[learner::DropReason::kWrongRun], foreign);
+  EXPECT_EQ(learner.dropStats()[learner::DropReason::kMalformed], 1);
+  EXPECT_EQ(learner.dropStats()[learner::DropReason::kNonFinite], nan_chunks);
   EXPECT_FALSE(fs::exists(dir / "metrics.csv"));
 
   // The next good batch goes through, and its stats carry the drops.
@@ -236,14 +236,14 @@ TEST(LearnerNode, WithARunKeyChunksSignedWithAnotherKeyAreCountedUnauthenticated
   const int forged = static_cast<int>(chunks.size());
   EXPECT_FALSE(stepUntilUpdate(learner, 50));
   EXPECT_EQ(learner.version(), 0);
-  EXPECT_EQ(learner.dropStats()[transport::DropReason::kUnauthenticated], forged);
-  EXPECT_EQ(learner.dropStats()[transport::DropReason::kAccepted], 0);
+  EXPECT_EQ(learner.dropStats()[learner::DropReason::kUnauthenticated], forged);
+  EXPECT_EQ(learner.dropStats()[learner::DropReason::kAccepted], 0);
 
   // The same rollout, same numbering, signed with the run key: the forged copies left no trace.
   actor.send(learner.transport(), 8, 0, 0);
   ASSERT_TRUE(stepUntilUpdate(learner));
   EXPECT_EQ(learner.version(), 1);
-  EXPECT_EQ(learner.dropStats()[transport::DropReason::kDuplicate], 0);
+  EXPECT_EQ(learner.dropStats()[learner::DropReason::kDuplicate], 0);
   EXPECT_EQ(learner.droppedChunks(), forged);
   int64_t reported = -1;
   for (int i = 0; i < stats.num_drop_reasons; ++i)

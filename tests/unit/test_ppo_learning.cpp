@@ -77,7 +77,7 @@ double collect(model::ActorCritic<float>& model, MirrorBandit& env, RolloutBuffe
   const int E = buffer.numEnvs();
   Vec<float> log_std(buffer.actDim());
   model.logStd(log_std);
-  buffer.logStds().colwise() = log_std;
+  buffer.envLogStds().colwise() = log_std;
   for (int t = 0; t < buffer.horizon(); ++t) {
     auto obs = buffer.obs().middleCols(t * E, E);
     auto means = buffer.means().middleCols(t * E, E);

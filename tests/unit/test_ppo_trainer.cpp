@@ -62,7 +62,7 @@ void fillOneStepBatch(Rig& s, Rng& rng) {
   b.means() = s.model->actMean(b.obs());
   Vec<float> log_std(b.actDim());
   s.model->logStd(log_std);
-  b.logStds().colwise() = log_std;
+  b.envLogStds().colwise() = log_std;
   model::gaussian::sample<float>(b.means(), log_std, rng, b.actions());
   model::gaussian::logProb<float>(b.means(), log_std, b.actions(), b.logProbs());
   for (int t = 0; t < b.horizon(); ++t)

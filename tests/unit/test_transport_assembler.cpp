@@ -7,13 +7,17 @@
 #include <set>
 #include <vector>
 
-#include "common/transport/batch_collector.hpp"
-#include "common/transport/rollout_assembler.hpp"
-#include "common/transport/rollout_chunker.hpp"
+#include "learner/intake/batch_collector.hpp"
+#include "learner/intake/rollout_assembler.hpp"
+#include "actors/rollout_chunker.hpp"
 #include "test_transport_support.hpp"
 
 namespace masa::transport {
 namespace {
+
+// The actors' chunking and the learner's intake, tested against each other and the wire.
+using namespace masa::actor;
+using namespace masa::learner;
 
 using testing::encode;
 using testing::fillRandomRollout;
@@ -46,7 +50,7 @@ CollectorConfig collectorConfig(int num_envs, int lag = 0) {
 // A rollout of 20 TriFinger environments split 4 per chunk (5 chunks), with truncations and
 // episodes in every chunk so their validation is exercised.
 std::vector<masa::lcmt_rollout_chunk> makeChunks(int64_t version, int64_t seq = 0, int actor = 0) {
-  ActorRollout r;
+  rollout::Rollout r;
   fillRandomRollout(r, kTrifinger, 100 + seq, 0.1);
   RolloutChunker chunker(4 * RolloutChunker::envBytes(kTrifinger.horizon, kTrifinger.obs_dim, kTrifinger.act_dim) + 3000);
   const auto span = chunker.split(r, RolloutIdentity{.run_id = kRun, .actor_id = actor, .rollout_seq = seq,
@@ -74,19 +78,19 @@ TEST(RolloutAssembler, LostChunksLoseOnlyTheirEnvironmentsAndNothingWaits) {
     collector.add(*v.chunk);
   }
   ASSERT_TRUE(collector.ready());
-  RolloutBatch batch;
-  ASSERT_TRUE(collector.take(batch));
+  testing::TakenBatch batch(collector.config());
+  ASSERT_TRUE(take(collector, batch));
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
-  const std::set<int> got(batch.env_index.begin(), batch.env_index.end());
+  const std::set<int> got(batch.origin.env_index.begin(), batch.origin.env_index.end());
   EXPECT_EQ(got, arrived);
   // The surviving environments carry their own data: obs of batch env b equal the chunk's.
-  for (int b = 0; b < batch.data.num_envs; ++b) {
-    const int e = batch.env_index[b];
+  for (int b = 0; b < batch.data().num_envs; ++b) {
+    const int e = batch.origin.env_index[b];
     for (const auto& c : chunks) {
       if (e < c.env_offset || e >= c.env_offset + c.num_envs) continue;
       const int j = e - c.env_offset;
-      EXPECT_EQ(batch.data.obsAt(0, b)[0], c.obs[j * c.obs_dim]);
-      EXPECT_EQ(batch.data.obsAt(c.horizon, b)[3], c.obs[(c.horizon * c.num_envs + j) * c.obs_dim + 3]);
+      EXPECT_EQ(batch.data().obsAt(0, b)[0], c.obs[j * c.obs_dim]);
+      EXPECT_EQ(batch.data().obsAt(c.horizon, b)[3], c.obs[(c.horizon * c.num_envs + j) * c.obs_dim + 3]);
     }
   }
   // The next rollout goes through as if nothing happened.

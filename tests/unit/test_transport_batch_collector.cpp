@@ -1,14 +1,19 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
-#include "common/transport/batch_collector.hpp"
-#include "common/transport/rollout_assembler.hpp"
-#include "common/transport/rollout_chunker.hpp"
+#include "learner/intake/batch_collector.hpp"
+#include "learner/intake/rollout_assembler.hpp"
+#include "actors/rollout_chunker.hpp"
 #include "test_transport_support.hpp"
 
 namespace masa::transport {
 namespace {
+
+// The actors' chunking and the learner's intake, tested against each other and the wire.
+using namespace masa::actor;
+using namespace masa::learner;
 
 using testing::fillRandomRollout;
 using testing::RolloutShape;
@@ -50,10 +55,11 @@ class Feeder {
     return accepted;
   }
   const RolloutAssembler& assembler() const { return assembler_; }
+  const rollout::Rollout& lastRollout() const { return rollout_; }
 
  private:
   RolloutAssembler assembler_;
-  ActorRollout rollout_;
+  rollout::Rollout rollout_;
   int64_t seq_ = 0;
 };
 
@@ -72,21 +78,21 @@ CollectorConfig collectorConfig(int num_envs, int lag, int capacity = 0) {
 TEST(BatchCollector, EmitsABatchOnlyOnceEnoughEnvironmentsArrived) {
   Feeder feeder(0);
   BatchCollector collector(collectorConfig(10, 0));
-  RolloutBatch batch;
+  testing::TakenBatch batch(collector.config());
   EXPECT_EQ(feeder.send(collector, 0), 3);
   EXPECT_EQ(collector.bufferedEnvs(), 6);
   EXPECT_FALSE(collector.ready());
-  EXPECT_FALSE(collector.take(batch));
+  EXPECT_FALSE(take(collector, batch));
   EXPECT_EQ(feeder.send(collector, 0), 3);
   ASSERT_TRUE(collector.ready());
-  ASSERT_TRUE(collector.take(batch));
-  EXPECT_EQ(batch.data.num_envs, 10);
-  EXPECT_EQ(batch.data.horizon, kShape.horizon);
+  ASSERT_TRUE(take(collector, batch));
+  EXPECT_EQ(batch.data().num_envs, 10);
+  EXPECT_EQ(batch.data().horizon, kShape.horizon);
   EXPECT_EQ(collector.bufferedEnvs(), 2);  // the rest waits for the next batch
   EXPECT_EQ(collector.stats().batches, 1);
   // Arrival order: the first rollout's six environments, then four of the second.
-  for (int b = 0; b < 6; ++b) EXPECT_EQ(batch.env_index[b], b);
-  for (int b = 6; b < 10; ++b) EXPECT_EQ(batch.env_index[b], b - 6);
+  for (int b = 0; b < 6; ++b) EXPECT_EQ(batch.origin.env_index[b], b);
+  for (int b = 6; b < 10; ++b) EXPECT_EQ(batch.origin.env_index[b], b - 6);
 }
 
 TEST(BatchCollector, LagZeroIsStrictlyOnPolicy) {
@@ -114,15 +120,15 @@ TEST(BatchCollector, LagTwoMixesVersionsOldestFirstAndEvictsBeyondTheLag) {
   EXPECT_EQ(feeder.send(collector, 2), 3);
   EXPECT_EQ(feeder.send(collector, 1), 0);  // three behind
   EXPECT_EQ(feeder.send(collector, 3), 3);
-  RolloutBatch batch;
-  ASSERT_TRUE(collector.take(batch));
-  EXPECT_EQ(batch.env_version, std::vector<int64_t>({2, 2, 2, 2, 2, 2}));
+  testing::TakenBatch batch(collector.config());
+  ASSERT_TRUE(take(collector, batch));
+  EXPECT_EQ(batch.origin.env_version, std::vector<int64_t>({2, 2, 2, 2, 2, 2}));
   // Versions 3 and 4 remain; moving to 6 leaves only version 4 within the lag.
   collector.setLearnerVersion(6);
   EXPECT_EQ(collector.bufferedEnvs(), 6);
   EXPECT_EQ(collector.stats().envs_stale, 6);
-  ASSERT_TRUE(collector.take(batch));
-  EXPECT_EQ(batch.env_version, std::vector<int64_t>(6, 4));
+  ASSERT_TRUE(take(collector, batch));
+  EXPECT_EQ(batch.origin.env_version, std::vector<int64_t>(6, 4));
 }
 
 TEST(BatchCollector, FullPoolMakesRoomByEvictingOlderVersionsOnly) {
@@ -135,22 +141,22 @@ TEST(BatchCollector, FullPoolMakesRoomByEvictingOlderVersionsOnly) {
   EXPECT_EQ(collector.stats().envs_overflow, 6);
   feeder.send(collector, 5);  // newer: replaces the version-3 environments
   EXPECT_EQ(collector.stats().envs_overflow, 12);
-  RolloutBatch batch;
-  ASSERT_TRUE(collector.take(batch));
-  EXPECT_EQ(batch.env_version, std::vector<int64_t>(6, 5));
+  testing::TakenBatch batch(collector.config());
+  ASSERT_TRUE(take(collector, batch));
+  EXPECT_EQ(batch.origin.env_version, std::vector<int64_t>(6, 5));
 }
 
 TEST(BatchCollector, EpisodesAndTruncationsFollowTheirEnvironmentIntoTheBatch) {
   Feeder feeder(0);
   BatchCollector collector(collectorConfig(6, 0));
   feeder.send(collector, 0, 0.3);
-  RolloutBatch batch;
-  ASSERT_TRUE(collector.take(batch));
-  const ActorRollout& d = batch.data;
+  testing::TakenBatch batch(collector.config());
+  ASSERT_TRUE(take(collector, batch));
+  const rollout::Rollout& d = batch.data();
   ASSERT_GT(d.numFinal(), 0);
   ASSERT_GE(d.numEpisodes(), d.numFinal());
   int truncated = 0;
-  for (int8_t x : d.truncated) truncated += x;
+  for (uint8_t x : d.truncated) truncated += x;
   EXPECT_EQ(truncated, d.numFinal());
   for (int i = 0; i < d.numFinal(); ++i) EXPECT_EQ(d.truncated[d.final_index[i]], 1);
   for (int i = 0; i < d.numEpisodes(); ++i) {
@@ -158,6 +164,63 @@ TEST(BatchCollector, EpisodesAndTruncationsFollowTheirEnvironmentIntoTheBatch) {
     EXPECT_LT(d.episode_env[i], 6);
   }
   EXPECT_EQ(d.episode_term_sums.size(), static_cast<std::size_t>(d.numEpisodes()) * 2);
+}
+
+// The truncations (step, observation) and episodes (env, return, length, success, terms) of a
+// rollout, in a canonical order: a batch must carry exactly those of the rollout it came from.
+using Events = std::vector<std::vector<float>>;
+Events eventsOf(const rollout::Rollout& r) {
+  Events out;
+  for (int i = 0; i < r.numFinal(); ++i) {
+    std::vector<float> f{0.0f, static_cast<float>(r.final_index[i])};
+    f.insert(f.end(), r.finalObs(i), r.finalObs(i) + r.obs_dim);
+    out.push_back(f);
+  }
+  const int K = r.numTerms();
+  for (int i = 0; i < r.numEpisodes(); ++i) {
+    std::vector<float> ep{1.0f, static_cast<float>(r.episode_env[i]), r.episode_return[i],
+                          static_cast<float>(r.episode_length[i]), static_cast<float>(r.episode_success[i])};
+    ep.insert(ep.end(), &r.episode_term_sums[static_cast<std::size_t>(i) * K],
+              &r.episode_term_sums[static_cast<std::size_t>(i) * K] + K);
+    out.push_back(ep);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Slots are reused after a batch is taken and when a newer environment evicts an older one; the
+// events of a slot's previous environment must not follow the new one into a batch.
+TEST(BatchCollector, ReusedSlotsCarryOnlyTheEventsOfTheirNewEnvironments) {
+  Feeder feeder(5);
+  feeder.setLearnerVersion(5);  // versions 0..5 are all fresh enough
+  BatchCollector collector(collectorConfig(6, 5, /*capacity=*/12));
+  collector.setLearnerVersion(5);
+  testing::TakenBatch batch(collector.config());
+  feeder.send(collector, 0, 0.3);
+  const Events first = eventsOf(feeder.lastRollout());
+  feeder.send(collector, 0, 0.3);
+  const Events second = eventsOf(feeder.lastRollout());
+  ASSERT_FALSE(first.empty());
+  ASSERT_TRUE(take(collector, batch));
+  EXPECT_EQ(eventsOf(batch.data()), first);
+  feeder.send(collector, 1, 0.3);  // into the slots the first batch freed
+  const Events third = eventsOf(feeder.lastRollout());
+  ASSERT_TRUE(take(collector, batch));
+  EXPECT_EQ(eventsOf(batch.data()), second);
+  ASSERT_TRUE(take(collector, batch));
+  EXPECT_EQ(eventsOf(batch.data()), third);
+  batch.buffer.checkFinalObs();
+
+  // Eviction: a full pool of version 2 gives its slots to version 3.
+  BatchCollector full(collectorConfig(6, 5, /*capacity=*/6));
+  full.setLearnerVersion(5);
+  feeder.send(full, 2, 0.3);
+  feeder.send(full, 3, 0.3);
+  const Events newer = eventsOf(feeder.lastRollout());
+  EXPECT_EQ(full.stats().envs_overflow, 6);
+  ASSERT_TRUE(take(full, batch));
+  EXPECT_EQ(eventsOf(batch.data()), newer);
+  batch.buffer.checkFinalObs();
 }
 
 }  // namespace

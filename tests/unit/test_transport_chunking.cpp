@@ -5,14 +5,18 @@
 #include <numeric>
 #include <vector>
 
-#include "common/transport/batch_collector.hpp"
-#include "common/transport/rollout_assembler.hpp"
-#include "common/transport/rollout_chunker.hpp"
+#include "learner/intake/batch_collector.hpp"
+#include "learner/intake/rollout_assembler.hpp"
+#include "actors/rollout_chunker.hpp"
 #include "common/transport/wire_guard.hpp"
 #include "test_transport_support.hpp"
 
 namespace masa::transport {
 namespace {
+
+// The actors' chunking and the learner's intake, tested against each other and the wire.
+using namespace masa::actor;
+using namespace masa::learner;
 
 using testing::encode;
 using testing::fillRandomRollout;
@@ -26,7 +30,7 @@ bool bitwiseEqual(const std::vector<T>& a, const std::vector<T>& b) {
 }
 
 // Episodes of `r` as tuples ordered by environment (stable), the order a batch keeps them in.
-std::vector<std::vector<float>> episodesByEnv(const ActorRollout& r) {
+std::vector<std::vector<float>> episodesByEnv(const rollout::Rollout& r) {
   std::vector<int> idx(r.numEpisodes());
   std::iota(idx.begin(), idx.end(), 0);
   std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return r.episode_env[a] < r.episode_env[b]; });
@@ -61,7 +65,7 @@ struct Pipeline {
 
 void expectSplitReassemblesExactly(const RolloutShape& shape, int budget, uint64_t seed) {
   SCOPED_TRACE(::testing::Message() << "budget " << budget << " obs " << shape.obs_dim << " seed " << seed);
-  ActorRollout r;
+  rollout::Rollout r;
   fillRandomRollout(r, shape, seed, 0.08);
   RolloutChunker chunker(budget);
   const auto chunks = chunker.split(r, RolloutIdentity{.run_id = 5, .actor_id = 1, .rollout_seq = 0});
@@ -94,9 +98,9 @@ void expectSplitReassemblesExactly(const RolloutShape& shape, int budget, uint64
 
   Pipeline p(shape, shape.num_envs);
   for (const auto& c : chunks) p.deliver(c);
-  RolloutBatch batch;
-  ASSERT_TRUE(p.collector.take(batch));
-  const ActorRollout& b = batch.data;
+  testing::TakenBatch batch(p.collector.config());
+  ASSERT_TRUE(take(p.collector, batch));
+  const rollout::Rollout& b = batch.data();
   EXPECT_TRUE(bitwiseEqual(b.obs, r.obs));
   EXPECT_TRUE(bitwiseEqual(b.actions, r.actions));
   EXPECT_TRUE(bitwiseEqual(b.mean, r.mean));
@@ -104,13 +108,13 @@ void expectSplitReassemblesExactly(const RolloutShape& shape, int budget, uint64
   EXPECT_TRUE(bitwiseEqual(b.reward, r.reward));
   EXPECT_TRUE(bitwiseEqual(b.terminated, r.terminated));
   EXPECT_TRUE(bitwiseEqual(b.truncated, r.truncated));
-  EXPECT_TRUE(bitwiseEqual(b.log_std, r.log_std));
+  EXPECT_TRUE(bitwiseEqual(b.env_log_std, r.env_log_std));
   EXPECT_TRUE(bitwiseEqual(b.final_index, r.final_index));
   EXPECT_TRUE(bitwiseEqual(b.final_obs, r.final_obs));
   EXPECT_EQ(episodesByEnv(b), episodesByEnv(r));
   for (int e = 0; e < shape.num_envs; ++e) {
-    EXPECT_EQ(batch.env_index[e], e);
-    EXPECT_EQ(batch.env_actor[e], 1);
+    EXPECT_EQ(batch.origin.env_index[e], e);
+    EXPECT_EQ(batch.origin.env_actor[e], 1);
   }
 }
 
@@ -129,7 +133,7 @@ TEST(RolloutChunker, ChunkCountIsCeilOfEnvsOverCapacityWithoutEvents) {
     int per_chunk;
   };
   for (const Case& c : {Case{{64, 32, 74, 21}, 3}, Case{{64, 16, 41, 9}, 14}}) {
-    ActorRollout r;
+    rollout::Rollout r;
     fillRandomRollout(r, c.shape, 3, 0.0);
     r.term_names.clear();
     const int cap = RolloutChunker::maxEnvsPerChunk(kDefaultChunkBytes, c.shape.horizon, c.shape.obs_dim,
@@ -143,7 +147,7 @@ TEST(RolloutChunker, ChunkCountIsCeilOfEnvsOverCapacityWithoutEvents) {
 }
 
 TEST(RolloutChunker, ReusesItsMessagesWithoutReallocating) {
-  ActorRollout r;
+  rollout::Rollout r;
   fillRandomRollout(r, kTrifinger, 1, 0.05);
   RolloutChunker chunker;
   const auto first = chunker.split(r, {});
@@ -159,7 +163,7 @@ TEST(RolloutChunker, ReusesItsMessagesWithoutReallocating) {
 }
 
 TEST(RolloutChunker, EnvironmentLargerThanTheBudgetGoesAloneAndIsCounted) {
-  ActorRollout r;
+  rollout::Rollout r;
   fillRandomRollout(r, kHumanoid, 1, 0.0);
   RolloutChunker chunker(10000);  // one humanoid environment is about 15.5 KB
   const auto chunks = chunker.split(r, {});
@@ -172,7 +176,7 @@ bool chunkWireLengthsFit(const void* data, int size) {
 }
 
 TEST(ChunkWireGuard, AcceptsEncodedChunksAndRejectsEveryTruncationOrLengthPastTheEnd) {
-  ActorRollout r;
+  rollout::Rollout r;
   fillRandomRollout(r, kTrifinger, 4, 0.1);
   RolloutChunker chunker(20000);
   const auto chunks = chunker.split(r, {});

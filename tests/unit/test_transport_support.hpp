@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "common/transport/actor_rollout.hpp"
+#include "common/rollout/rollout.hpp"
+#include "learner/intake/batch_collector.hpp"
+#include "learner/ppo/rollout_buffer.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
 namespace masa::transport::testing {
@@ -20,7 +22,7 @@ inline constexpr RolloutShape kTrifinger{20, 16, 41, 9};
 
 // Random contents everywhere; about `event_prob` of the steps end an episode (half by the time
 // limit, with a final observation), each finished episode with two reward terms.
-inline void fillRandomRollout(ActorRollout& r, const RolloutShape& s, uint64_t seed, double event_prob = 0.05) {
+inline void fillRandomRollout(rollout::Rollout& r, const RolloutShape& s, uint64_t seed, double event_prob = 0.05) {
   r.allocate(s.num_envs, s.horizon, s.obs_dim, s.act_dim, {"forward_velocity", "alive"});
   r.clearEvents();
   std::mt19937_64 rng(seed);
@@ -31,7 +33,9 @@ inline void fillRandomRollout(ActorRollout& r, const RolloutShape& s, uint64_t s
   for (float& x : r.mean) x = normal(rng);
   for (float& x : r.log_prob) x = normal(rng);
   for (float& x : r.reward) x = normal(rng);
-  for (float& x : r.log_std) x = normal(rng);
+  std::vector<float> log_std(s.act_dim);  // one policy: every environment acts with it
+  for (float& x : log_std) x = normal(rng);
+  r.setLogStd(log_std.data());
   std::vector<float> final_obs(s.obs_dim);
   for (int t = 0; t < s.horizon; ++t) {
     for (int e = 0; e < s.num_envs; ++e) {
@@ -51,6 +55,18 @@ inline void fillRandomRollout(ActorRollout& r, const RolloutShape& s, uint64_t s
       r.addEpisode(e, normal(rng), 1 + static_cast<int>(uniform(rng) * 500), success, terms);
     }
   }
+}
+
+// A batch as the learner takes it from its collector: the PPO buffer filled in place, and where
+// each of its columns came from.
+struct TakenBatch {
+  explicit TakenBatch(const learner::CollectorConfig& c) : buffer(c.num_envs, c.horizon, c.obs_dim, c.act_dim) {}
+  ppo::RolloutBuffer buffer;
+  learner::BatchOrigin origin;
+  const rollout::Rollout& data() const { return buffer.data(); }
+};
+inline bool take(learner::BatchCollector& collector, TakenBatch& batch) {
+  return collector.take(batch.buffer, &batch.origin);
 }
 
 // A small, valid parameter broadcast: 40 parameters and a 6-dimensional normalizer.

@@ -9,13 +9,17 @@
 #include <thread>
 
 #include "common/transport/lcm_url.hpp"
-#include "common/transport/rollout_assembler.hpp"
-#include "common/transport/rollout_chunker.hpp"
+#include "learner/intake/rollout_assembler.hpp"
+#include "actors/rollout_chunker.hpp"
 #include "common/transport/transport.hpp"
 #include "test_transport_support.hpp"
 
 namespace masa::transport {
 namespace {
+
+// The actors' chunking and the learner's intake, tested against each other and the wire.
+using namespace masa::actor;
+using namespace masa::learner;
 
 using Clock = std::chrono::steady_clock;
 
@@ -53,7 +57,7 @@ TEST(TransportUdpm, FiftyPacedChunksOfSixtyKilobytesMostlyArriveOnLoopback) {
 
   // 700 TriFinger environments (obs 41, act 9, T 16) = 50 chunks of 14 environments, ~57.5 KB.
   constexpr int kChunks = 50;
-  ActorRollout rollout;
+  rollout::Rollout rollout;
   testing::fillRandomRollout(rollout, {14 * kChunks, 16, 41, 9}, 7, 0.0);
   RolloutChunker chunker;
   const auto chunks = chunker.split(rollout, RolloutIdentity{.run_id = 21, .actor_id = 0, .rollout_seq = 0});

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string_view>
 
-namespace masa::transport {
+namespace masa::learner {
 
 enum class DropReason : int {
   kAccepted = 0,   // not a drop
@@ -39,4 +39,4 @@ struct DropStats {
   int64_t dropped() const;  // all reasons but kAccepted
 };
 
-}  // namespace masa::transport
+}  // namespace masa::learner

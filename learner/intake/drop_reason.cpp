@@ -1,6 +1,6 @@
-#include "common/transport/drop_reason.hpp"
+#include "learner/intake/drop_reason.hpp"
 
-namespace masa::transport {
+namespace masa::learner {
 
 std::string_view dropReasonName(DropReason r) {
   switch (r) {
@@ -27,4 +27,4 @@ int64_t DropStats::dropped() const {
   return n;
 }
 
-}  // namespace masa::transport
+}  // namespace masa::learner

@@ -1,4 +1,4 @@
-#include "common/transport/rollout_assembler.hpp"
+#include "learner/intake/rollout_assembler.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -6,10 +6,13 @@
 #include <iostream>
 #include <new>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 
 #include "common/core/check.hpp"
+#include "common/rollout/chunk_layout.hpp"
 
-namespace masa::transport {
+namespace masa::learner {
 
 namespace {
 
@@ -84,12 +87,19 @@ DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
 
   // Length fields against the dimensions, and every array against its length field (a message
   // built in-process can disagree; a decoded one cannot).
+  // The counts first (they are part of the shape), then every length field against the one table
+  // of what a chunk of this shape holds (common/rollout/chunk_layout.hpp).
   const int64_t steps = T * n;
-  if (m.obs_len != (T + 1) * n * od || m.act_len != steps * ad || m.step_len != steps || m.log_std_len != ad ||
-      m.num_final < 0 || m.num_final > steps || m.final_obs_len != int64_t{m.num_final} * od ||
-      m.num_episodes < 0 || m.num_episodes > steps || m.num_terms < 0 || m.num_terms > cfg_.max_terms ||
-      m.term_sums_len != int64_t{m.num_episodes} * m.num_terms) {
+  if (m.num_final < 0 || m.num_final > steps || m.num_episodes < 0 || m.num_episodes > steps || m.num_terms < 0 ||
+      m.num_terms > cfg_.max_terms) {
     return DropReason::kBadLength;
+  }
+  const rollout::ChunkShape shape{T, n, od, ad, m.num_final, m.num_episodes, m.num_terms};
+  const std::pair<std::string_view, int64_t> lengths[] = {
+      {"obs_len", m.obs_len},         {"act_len", m.act_len},           {"step_len", m.step_len},
+      {"log_std_len", m.log_std_len}, {"final_obs_len", m.final_obs_len}, {"term_sums_len", m.term_sums_len}};
+  for (const auto& [field, value] : lengths) {
+    if (value != rollout::chunkLength(field, shape)) return DropReason::kBadLength;
   }
   if (!sizeIs(m.obs, m.obs_len) || !sizeIs(m.actions, m.act_len) || !sizeIs(m.mean, m.act_len) ||
       !sizeIs(m.log_prob, m.step_len) || !sizeIs(m.reward, m.step_len) || !sizeIs(m.terminated, m.step_len) ||
@@ -354,12 +364,12 @@ Verdict RolloutAssembler::accept(const masa::lcmt_rollout_chunk& msg) {
 
 Verdict RolloutAssembler::acceptEncoded(const void* data, int size) {
   clearArrays(decoded_);
-  const WireVerdict wire = decodeChecked(data, size, decoded_);
-  if (wire != WireVerdict::kOk) {
+  const transport::WireVerdict wire = transport::decodeChecked(data, size, decoded_);
+  if (wire != transport::WireVerdict::kOk) {
     ++wire_rejects_[static_cast<int>(wire)];
     return finish(DropReason::kMalformed, nullptr);
   }
   return accept(decoded_);
 }
 
-}  // namespace masa::transport
+}  // namespace masa::learner

@@ -1,26 +1,45 @@
-#include "common/transport/rollout_chunker.hpp"
+#include "actors/rollout_chunker.hpp"
 
 #include <algorithm>
 #include <cstring>
+#include <string_view>
 
 #include "common/core/check.hpp"
+#include "common/rollout/chunk_layout.hpp"
 
-namespace masa::transport {
+namespace masa::actor {
 
 RolloutChunker::RolloutChunker(int byte_budget) : budget_(byte_budget) {
   MASA_CHECK(byte_budget > 0, "chunk byte budget must be positive, got " << byte_budget);
 }
 
+// Every size below is a difference of chunkEncodedBytes, which walks the wire table: the budget
+// arithmetic follows the .lcm file without a formula of its own.
 int RolloutChunker::emptyChunkBytes(int act_dim, const std::vector<std::string>& term_names) {
-  // Hash, 11 header fields, the 9 length fields, log_std and the term names.
-  int bytes = 8 + (8 + 4 + 8 + 4 + 4 + 8 + 4 * 5) + 4 * 9 + 4 * act_dim;
-  for (const std::string& s : term_names) bytes += 4 + static_cast<int>(s.size()) + 1;
-  return bytes;
+  int64_t name_bytes = 0;
+  for (const std::string& s : term_names) name_bytes += static_cast<int64_t>(s.size());
+  rollout::ChunkShape shape;
+  shape.act_dim = act_dim;
+  shape.num_terms = static_cast<int64_t>(term_names.size());
+  return static_cast<int>(rollout::chunkEncodedBytes(shape, name_bytes));
 }
 
 int RolloutChunker::envBytes(int horizon, int obs_dim, int act_dim) {
-  const int t = horizon;
-  return 4 * (t + 1) * obs_dim + 2 * 4 * t * act_dim + 2 * 4 * t + 2 * t;
+  rollout::ChunkShape none{horizon, 0, obs_dim, act_dim}, one{horizon, 1, obs_dim, act_dim};
+  return static_cast<int>(rollout::chunkEncodedBytes(one, 0) - rollout::chunkEncodedBytes(none, 0));
+}
+
+int RolloutChunker::finalBytes(int obs_dim) {
+  rollout::ChunkShape none{0, 0, obs_dim}, one{0, 0, obs_dim};
+  one.num_final = 1;
+  return static_cast<int>(rollout::chunkEncodedBytes(one, 0) - rollout::chunkEncodedBytes(none, 0));
+}
+
+int RolloutChunker::episodeBytes(int num_terms) {
+  rollout::ChunkShape none, one;
+  none.num_terms = one.num_terms = num_terms;
+  one.num_episodes = 1;
+  return static_cast<int>(rollout::chunkEncodedBytes(one, 0) - rollout::chunkEncodedBytes(none, 0));
 }
 
 int RolloutChunker::maxEnvsPerChunk(int byte_budget, int horizon, int obs_dim, int act_dim,
@@ -29,7 +48,7 @@ int RolloutChunker::maxEnvsPerChunk(int byte_budget, int horizon, int obs_dim, i
   return std::max(1, room / envBytes(horizon, obs_dim, act_dim));
 }
 
-void RolloutChunker::plan(const ActorRollout& r) {
+void RolloutChunker::plan(const rollout::Rollout& r) {
   const int E = r.num_envs;
   env_finals_.assign(E, 0);
   env_episodes_.assign(E, 0);
@@ -58,7 +77,7 @@ void RolloutChunker::plan(const ActorRollout& r) {
   chunk_envs_.push_back(n);
 }
 
-std::span<const masa::lcmt_rollout_chunk> RolloutChunker::split(const ActorRollout& r, const RolloutIdentity& id) {
+std::span<const masa::lcmt_rollout_chunk> RolloutChunker::split(const rollout::Rollout& r, const RolloutIdentity& id) {
   MASA_CHECK(r.num_envs > 0 && r.horizon > 0, "rollout not allocated");
   MASA_CHECK(r.final_obs.size() == r.final_index.size() * r.obs_dim, "final_obs size does not match final_index");
   MASA_CHECK(r.episode_term_sums.size() == r.episode_env.size() * r.term_names.size(),
@@ -69,23 +88,26 @@ std::span<const masa::lcmt_rollout_chunk> RolloutChunker::split(const ActorRollo
     // New messages are reserved for the largest chunk this shape allows, so later rollouts whose
     // packing shifts still fit without reallocating.
     const int cap = std::min(r.num_envs, maxEnvsPerChunk(budget_, r.horizon, r.obs_dim, r.act_dim, r.term_names));
-    const std::size_t steps = static_cast<std::size_t>(cap) * r.horizon;
+    // At most one truncation and one episode per step (the chunk layout's lengths at that shape).
+    const int64_t steps = int64_t{cap} * r.horizon;
+    const rollout::ChunkShape most{r.horizon, cap, r.obs_dim, r.act_dim, steps, steps, r.numTerms()};
+    auto length = [&](std::string_view field) { return static_cast<std::size_t>(rollout::chunkLength(field, most)); };
     while (static_cast<int>(chunks_.size()) < num_chunks) {
       masa::lcmt_rollout_chunk& c = chunks_.emplace_back();
-      c.obs.reserve((steps + cap) * r.obs_dim);
-      c.actions.reserve(steps * r.act_dim);
-      c.mean.reserve(steps * r.act_dim);
-      c.log_prob.reserve(steps);
-      c.reward.reserve(steps);
-      c.terminated.reserve(steps);
-      c.truncated.reserve(steps);
-      c.final_index.reserve(steps);
-      c.final_obs.reserve(steps * r.obs_dim);
-      c.episode_env.reserve(steps);
-      c.episode_return.reserve(steps);
-      c.episode_length.reserve(steps);
-      c.episode_success.reserve(steps);
-      c.episode_term_sums.reserve(steps * r.term_names.size());
+      c.obs.reserve(length("obs_len"));
+      c.actions.reserve(length("act_len"));
+      c.mean.reserve(length("act_len"));
+      c.log_prob.reserve(length("step_len"));
+      c.reward.reserve(length("step_len"));
+      c.terminated.reserve(length("step_len"));
+      c.truncated.reserve(length("step_len"));
+      c.final_index.reserve(length("num_final"));
+      c.final_obs.reserve(length("final_obs_len"));
+      c.episode_env.reserve(length("num_episodes"));
+      c.episode_return.reserve(length("num_episodes"));
+      c.episode_length.reserve(length("num_episodes"));
+      c.episode_success.reserve(length("num_episodes"));
+      c.episode_term_sums.reserve(length("term_sums_len"));
     }
   }
   const int empty = emptyChunkBytes(r.act_dim, r.term_names);
@@ -105,17 +127,19 @@ std::span<const masa::lcmt_rollout_chunk> RolloutChunker::split(const ActorRollo
 namespace {
 // Copies rows t = 0..rows-1 of n consecutive envs starting at `offset` (dim values each) from an
 // E-env step-major array into an n-env step-major array.
-template <typename T>
-void copyRows(std::vector<T>& dst, const std::vector<T>& src, int rows, int E, int offset, int n, int dim) {
+// (The flags are uint8_t in memory and int8_t on the wire: the same bytes.)
+template <typename D, typename S>
+void copyRows(std::vector<D>& dst, const std::vector<S>& src, int rows, int E, int offset, int n, int dim) {
+  static_assert(sizeof(D) == sizeof(S));
   const std::size_t row = static_cast<std::size_t>(n) * dim;
   dst.resize(rows * row);
   for (int t = 0; t < rows; ++t) {
-    std::memcpy(dst.data() + t * row, src.data() + (static_cast<std::size_t>(t) * E + offset) * dim, row * sizeof(T));
+    std::memcpy(dst.data() + t * row, src.data() + (static_cast<std::size_t>(t) * E + offset) * dim, row * sizeof(D));
   }
 }
 }  // namespace
 
-void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const ActorRollout& r, const RolloutIdentity& id, int index,
+void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const rollout::Rollout& r, const RolloutIdentity& id, int index,
                           int num_chunks, int offset, int n) const {
   const int E = r.num_envs, T = r.horizon;
   c.run_id = id.run_id;
@@ -140,7 +164,12 @@ void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const ActorRollout& r, co
   c.obs_len = static_cast<int32_t>(c.obs.size());
   c.act_len = static_cast<int32_t>(c.actions.size());
   c.step_len = static_cast<int32_t>(c.log_prob.size());
-  c.log_std.assign(r.log_std.begin(), r.log_std.end());
+  // One log std per chunk on the wire: an actor's environments all act with the same policy.
+  const float* log_std = r.logStdOf(offset);
+  for (int e = offset + 1; e < offset + n; ++e)
+    MASA_CHECK(std::memcmp(r.logStdOf(e), log_std, r.act_dim * sizeof(float)) == 0,
+               "environments " << offset << " and " << e << " of one chunk acted with different log stds");
+  c.log_std.assign(log_std, log_std + r.act_dim);
   c.log_std_len = static_cast<int32_t>(c.log_std.size());
 
   // Truncations stay in ascending order: the global order is (t, e) and the chunk's envs are a
@@ -179,4 +208,4 @@ void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const ActorRollout& r, co
   c.term_sums_len = static_cast<int32_t>(c.episode_term_sums.size());
 }
 
-}  // namespace masa::transport
+}  // namespace masa::actor

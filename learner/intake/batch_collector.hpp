@@ -3,18 +3,21 @@
 // max_policy_lag versions behind the learner (0 = strictly on-policy). Staler environments are
 // evicted when the learner's version advances, and counted.
 //
-// Storage is a pool of environment slots allocated once (capacity_envs); chunks are copied in as
-// they arrive, and take() writes a batch in the step-major ActorRollout layout.
+// The pool is one rollout::Rollout of capacity_envs environments allocated once, in the layout of
+// the chunks and of ppo::RolloutBuffer (step-major): each environment of a chunk is copied into a
+// free slot (a column of the pool) as it arrives, and take() copies the chosen columns straight
+// into the PPO buffer. Truncations and episodes are kept in the pool's own lists, indexed by slot.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "common/transport/actor_rollout.hpp"
-#include "common/transport/rollout_assembler.hpp"
+#include "common/rollout/rollout.hpp"
+#include "learner/intake/rollout_assembler.hpp"
+#include "learner/ppo/rollout_buffer.hpp"
 
-namespace masa::transport {
+namespace masa::learner {
 
 struct CollectorConfig {
   int num_envs = 0;  // environments per batch (ppo.num_envs)
@@ -33,10 +36,8 @@ struct CollectorStats {
   int64_t batches = 0;        // batches handed out
 };
 
-// A training batch: num_envs environments x T steps, plus where each environment came from.
-struct RolloutBatch {
-  ActorRollout data;                 // episodes and truncations renumbered to batch env indices
-  std::vector<float> env_log_std;    // num_envs x act_dim: behaviour log std of each environment
+// Where each environment of a batch came from.
+struct BatchOrigin {
   std::vector<int64_t> env_version;  // policy version each environment acted with
   std::vector<int32_t> env_actor;    // actor id
   std::vector<int32_t> env_index;    // environment index within its actor
@@ -55,9 +56,11 @@ class BatchCollector {
 
   int bufferedEnvs() const { return used_; }
   bool ready() const { return used_ >= cfg_.num_envs; }
-  // When ready, fills `out` with num_envs environments, oldest version first (then arrival
-  // order), frees their slots and returns true; otherwise returns false and leaves `out` alone.
-  bool take(RolloutBatch& out);
+  // When ready, fills `out` (num_envs x horizon, the collector's dimensions) with num_envs
+  // environments, oldest version first (then arrival order), episodes and truncations renumbered to
+  // batch columns, frees their slots and returns true; otherwise returns false and leaves `out`
+  // alone. `origin`, when given, says where each column came from.
+  bool take(ppo::RolloutBuffer& out, BatchOrigin* origin = nullptr);
 
   const CollectorStats& stats() const { return stats_; }
   const CollectorConfig& config() const { return cfg_; }
@@ -65,17 +68,8 @@ class BatchCollector {
  private:
   int freeSlotFor(int64_t version);  // -1 when full of environments at least as new
   void release(int slot);
-
-  struct Final {
-    int t;
-    std::vector<float> obs;
-  };
-  struct Episode {
-    float ret;
-    int32_t length;
-    int8_t success;
-    std::vector<float> term_sums;
-  };
+  // Forgets the truncations and episodes of released slots (before a slot is reused or read).
+  void dropEventsOfFreeSlots();
 
   CollectorConfig cfg_;
   int capacity_ = 0;
@@ -84,20 +78,17 @@ class BatchCollector {
   uint64_t arrivals_ = 0;
   CollectorStats stats_;
 
-  // Slot s owns rows [s * rows, (s + 1) * rows) of each pool, environment-major.
-  std::vector<float> obs_, actions_, mean_, log_prob_, reward_, log_std_;
-  std::vector<int8_t> terminated_, truncated_;
+  // Slot s is environment s of the pool. Its truncations have final_index t * capacity + s and
+  // its episodes episode_env s, in arrival order (not sorted: take() orders them).
+  rollout::Rollout pool_;
+  bool events_stale_ = false;  // some released slot may still have events in pool_
   std::vector<char> in_use_;
   std::vector<int64_t> slot_version_;
   std::vector<uint64_t> slot_arrival_;
   std::vector<int32_t> slot_actor_, slot_env_;
-  std::vector<std::vector<Final>> finals_;
-  std::vector<int> num_finals_;
-  std::vector<std::vector<Episode>> episodes_;
-  std::vector<int> num_episodes_;
-  std::vector<int> free_, order_;
-  std::vector<int> chunk_slots_;  // slot of each environment of the chunk being added (-1: none)
-  std::vector<std::pair<int32_t, const float*>> batch_finals_;
+  std::vector<int> free_, order_, batch_column_;
+  std::vector<int> chunk_slots_;                          // slot of each environment of the chunk being added
+  std::vector<std::pair<int32_t, int32_t>> batch_finals_;  // (batch step index, pool final entry)
 };
 
-}  // namespace masa::transport
+}  // namespace masa::learner

@@ -1,12 +1,12 @@
-#include "common/transport/actor_rollout.hpp"
+#include "common/rollout/rollout.hpp"
 
 #include <algorithm>
 
 #include "common/core/check.hpp"
 
-namespace masa::transport {
+namespace masa::rollout {
 
-void ActorRollout::allocate(int e, int t, int od, int ad, const std::vector<std::string>& names) {
+void Rollout::allocate(int e, int t, int od, int ad, const std::vector<std::string>& names) {
   MASA_CHECK(e > 0 && t > 0 && od > 0 && ad > 0,
              "rollout shape must be positive: E=" << e << " T=" << t << " obs=" << od << " act=" << ad);
   if (e == num_envs && t == horizon && od == obs_dim && ad == act_dim && names == term_names) {
@@ -25,7 +25,7 @@ void ActorRollout::allocate(int e, int t, int od, int ad, const std::vector<std:
   reward.assign(steps, 0.0f);
   terminated.assign(steps, 0);
   truncated.assign(steps, 0);
-  log_std.assign(ad, 0.0f);
+  env_log_std.assign(static_cast<std::size_t>(e) * ad, 0.0f);
   clearEvents();
   final_index.reserve(steps);
   final_obs.reserve(steps * od);
@@ -36,7 +36,7 @@ void ActorRollout::allocate(int e, int t, int od, int ad, const std::vector<std:
   episode_term_sums.reserve(steps * names.size());
 }
 
-void ActorRollout::clearEvents() {
+void Rollout::clearEvents() {
   final_index.clear();
   final_obs.clear();
   episode_env.clear();
@@ -46,7 +46,7 @@ void ActorRollout::clearEvents() {
   episode_term_sums.clear();
 }
 
-void ActorRollout::addFinal(int t, int e, const float* pre_reset_obs) {
+void Rollout::addFinal(int t, int e, const float* pre_reset_obs) {
   MASA_CHECK(t >= 0 && t < horizon && e >= 0 && e < num_envs, "final step (" << t << ", " << e << ") out of range");
   const int idx = static_cast<int>(step(t, e));
   MASA_CHECK(final_index.empty() || final_index.back() < idx, "finals must be added in ascending step order");
@@ -54,7 +54,11 @@ void ActorRollout::addFinal(int t, int e, const float* pre_reset_obs) {
   final_obs.insert(final_obs.end(), pre_reset_obs, pre_reset_obs + obs_dim);
 }
 
-void ActorRollout::addEpisode(int e, float ret, int length, int8_t success, const float* term_sums) {
+void Rollout::setLogStd(const float* log_std) {
+  for (int e = 0; e < num_envs; ++e) std::copy_n(log_std, act_dim, logStdOf(e));
+}
+
+void Rollout::addEpisode(int e, float ret, int length, int8_t success, const float* term_sums) {
   MASA_CHECK(e >= 0 && e < num_envs, "episode env " << e << " out of range");
   episode_env.push_back(e);
   episode_return.push_back(ret);
@@ -63,4 +67,4 @@ void ActorRollout::addEpisode(int e, float ret, int length, int8_t success, cons
   if (numTerms() > 0) episode_term_sums.insert(episode_term_sums.end(), term_sums, term_sums + numTerms());
 }
 
-}  // namespace masa::transport
+}  // namespace masa::rollout

@@ -25,11 +25,11 @@
 #include <optional>
 #include <vector>
 
-#include "common/transport/drop_reason.hpp"
+#include "learner/intake/drop_reason.hpp"
 #include "common/transport/wire_guard.hpp"
 #include "masa/lcmt_rollout_chunk.hpp"
 
-namespace masa::transport {
+namespace masa::learner {
 
 struct AssemblerConfig {
   int64_t run_id = 0;
@@ -90,7 +90,7 @@ class RolloutAssembler {
 
   const DropStats& stats() const { return stats_; }
   // Why the wire guard rejected the bytes acceptEncoded counted as kMalformed.
-  const WireRejects& wireRejects() const { return wire_rejects_; }
+  const transport::WireRejects& wireRejects() const { return wire_rejects_; }
   const AssemblerConfig& config() const { return cfg_; }
   // All zero for an actor id never seen.
   const ActorTally& actorTally(int actor_id) const;
@@ -133,7 +133,7 @@ class RolloutAssembler {
   AssemblerConfig cfg_;
   int64_t version_ = 0;
   DropStats stats_;
-  WireRejects wire_rejects_{};
+  transport::WireRejects wire_rejects_{};
   std::vector<ActorWindow> actors_;  // indexed by actor_id, grown on first sight
   masa::lcmt_rollout_chunk decoded_;  // reused by acceptEncoded
 
@@ -143,4 +143,4 @@ class RolloutAssembler {
   bool warned_[kNumDropReasons] = {};
 };
 
-}  // namespace masa::transport
+}  // namespace masa::learner

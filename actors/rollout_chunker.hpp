@@ -12,10 +12,10 @@
 #include <span>
 #include <vector>
 
-#include "common/transport/actor_rollout.hpp"
+#include "common/rollout/rollout.hpp"
 #include "masa/lcmt_rollout_chunk.hpp"
 
-namespace masa::transport {
+namespace masa::actor {
 
 // Encoded bytes per chunk. Below LCM's 64 KB fragmentation threshold with room for the channel
 // name and LCM's own header.
@@ -36,7 +36,7 @@ class RolloutChunker {
   // Fills the chunks of `rollout` and returns them; the span stays valid until the next split().
   // An environment that alone exceeds the budget (only possible with many truncations or
   // episodes) still goes out, alone in its chunk, and is counted in oversizeChunks().
-  std::span<const masa::lcmt_rollout_chunk> split(const ActorRollout& rollout, const RolloutIdentity& id);
+  std::span<const masa::lcmt_rollout_chunk> split(const rollout::Rollout& rollout, const RolloutIdentity& id);
 
   int byteBudget() const { return budget_; }
   long oversizeChunks() const { return oversize_; }
@@ -45,15 +45,16 @@ class RolloutChunker {
   static int emptyChunkBytes(int act_dim, const std::vector<std::string>& term_names);
   // Encoded bytes one environment adds, without its truncations and episodes.
   static int envBytes(int horizon, int obs_dim, int act_dim);
-  static int finalBytes(int obs_dim) { return 4 + 4 * obs_dim; }
-  static int episodeBytes(int num_terms) { return 4 + 4 + 4 + 1 + 4 * num_terms; }
+  // Encoded bytes one truncation / one finished episode adds.
+  static int finalBytes(int obs_dim);
+  static int episodeBytes(int num_terms);
   // Most environments one chunk can hold when they have no truncations or episodes (>= 1).
   static int maxEnvsPerChunk(int byte_budget, int horizon, int obs_dim, int act_dim,
                              const std::vector<std::string>& term_names = {});
 
  private:
-  void plan(const ActorRollout& r);
-  void fill(masa::lcmt_rollout_chunk& c, const ActorRollout& r, const RolloutIdentity& id, int index,
+  void plan(const rollout::Rollout& r);
+  void fill(masa::lcmt_rollout_chunk& c, const rollout::Rollout& r, const RolloutIdentity& id, int index,
             int num_chunks, int offset, int n) const;
 
   int budget_;
@@ -63,4 +64,4 @@ class RolloutChunker {
   std::vector<int> chunk_offset_, chunk_envs_;  // the plan
 };
 
-}  // namespace masa::transport
+}  // namespace masa::actor

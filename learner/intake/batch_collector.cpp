@@ -1,0 +1,237 @@
+#include "learner/intake/batch_collector.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "common/core/check.hpp"
+
+namespace masa::learner {
+
+BatchCollector::BatchCollector(const CollectorConfig& config) : cfg_(config) {
+  MASA_CHECK(cfg_.num_envs > 0 && cfg_.horizon > 0 && cfg_.obs_dim > 0 && cfg_.act_dim > 0,
+             "collector needs num_envs, horizon, obs_dim and act_dim");
+  MASA_CHECK(cfg_.max_policy_lag >= 0, "max_policy_lag must be >= 0");
+  capacity_ = cfg_.capacity_envs > 0 ? cfg_.capacity_envs : 2 * cfg_.num_envs;
+  MASA_CHECK(capacity_ >= cfg_.num_envs, "capacity_envs " << capacity_ << " below num_envs " << cfg_.num_envs);
+  pool_.allocate(capacity_, cfg_.horizon, cfg_.obs_dim, cfg_.act_dim, cfg_.term_names);
+  const std::size_t C = capacity_;
+  in_use_.assign(C, 0);
+  slot_version_.assign(C, 0);
+  slot_arrival_.assign(C, 0);
+  slot_actor_.assign(C, 0);
+  slot_env_.assign(C, 0);
+  batch_column_.assign(C, -1);
+  free_.reserve(C);
+  for (int s = capacity_ - 1; s >= 0; --s) free_.push_back(s);
+  order_.reserve(C);
+}
+
+void BatchCollector::release(int s) {
+  in_use_[s] = 0;
+  free_.push_back(s);
+  --used_;
+  events_stale_ = true;
+}
+
+void BatchCollector::dropEventsOfFreeSlots() {
+  if (!events_stale_) return;
+  events_stale_ = false;
+  rollout::Rollout& p = pool_;
+  const int C = capacity_, od = p.obs_dim, K = p.numTerms();
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < p.final_index.size(); ++i) {
+    if (!in_use_[p.final_index[i] % C]) continue;
+    p.final_index[kept] = p.final_index[i];
+    std::memmove(&p.final_obs[kept * od], &p.final_obs[i * od], od * sizeof(float));
+    ++kept;
+  }
+  p.final_index.resize(kept);
+  p.final_obs.resize(kept * od);
+  kept = 0;
+  for (std::size_t i = 0; i < p.episode_env.size(); ++i) {
+    if (!in_use_[p.episode_env[i]]) continue;
+    p.episode_env[kept] = p.episode_env[i];
+    p.episode_return[kept] = p.episode_return[i];
+    p.episode_length[kept] = p.episode_length[i];
+    p.episode_success[kept] = p.episode_success[i];
+    std::memmove(&p.episode_term_sums[kept * K], &p.episode_term_sums[i * K], K * sizeof(float));
+    ++kept;
+  }
+  p.episode_env.resize(kept);
+  p.episode_return.resize(kept);
+  p.episode_length.resize(kept);
+  p.episode_success.resize(kept);
+  p.episode_term_sums.resize(kept * K);
+}
+
+void BatchCollector::setLearnerVersion(int64_t version) {
+  version_ = version;
+  for (int s = 0; s < capacity_; ++s) {
+    if (in_use_[s] && slot_version_[s] < version_ - cfg_.max_policy_lag) {
+      release(s);
+      ++stats_.envs_stale;
+    }
+  }
+}
+
+int BatchCollector::freeSlotFor(int64_t version) {
+  if (!free_.empty()) {
+    const int s = free_.back();
+    free_.pop_back();
+    return s;
+  }
+  // Full: make room by evicting the stalest environment, if it is older than the newcomer.
+  int victim = -1;
+  for (int s = 0; s < capacity_; ++s) {
+    if (slot_version_[s] < version && (victim < 0 || slot_version_[s] < slot_version_[victim] ||
+                                       (slot_version_[s] == slot_version_[victim] &&
+                                        slot_arrival_[s] < slot_arrival_[victim]))) {
+      victim = s;
+    }
+  }
+  if (victim < 0) return -1;
+  release(victim);
+  dropEventsOfFreeSlots();  // before the slot is reused: its events are the victim's
+  ++stats_.envs_overflow;
+  free_.pop_back();
+  return victim;
+}
+
+void BatchCollector::add(const ValidatedChunk& chunk) {
+  const masa::lcmt_rollout_chunk& m = chunk.msg();
+  MASA_CHECK(m.horizon == cfg_.horizon && m.obs_dim == cfg_.obs_dim && m.act_dim == cfg_.act_dim,
+             "chunk dimensions differ from the collector's (assembler and collector configured differently)");
+  const int n = m.num_envs, T = cfg_.horizon, od = cfg_.obs_dim, ad = cfg_.act_dim;
+  if (m.policy_version < version_ - cfg_.max_policy_lag) {
+    stats_.envs_stale += n;
+    return;
+  }
+  const int K = pool_.numTerms();
+  const bool terms_match = m.num_terms == K;
+  rollout::Rollout& p = pool_;
+  dropEventsOfFreeSlots();  // before free slots are reused: their events are their previous owners'
+  chunk_slots_.assign(n, -1);
+  for (int j = 0; j < n; ++j) {
+    const int s = freeSlotFor(m.policy_version);
+    chunk_slots_[j] = s;
+    if (s < 0) {
+      ++stats_.envs_overflow;
+      continue;
+    }
+    in_use_[s] = 1;
+    ++used_;
+    ++stats_.envs_added;
+    slot_version_[s] = m.policy_version;
+    slot_arrival_[s] = arrivals_++;
+    slot_actor_[s] = m.actor_id;
+    slot_env_[s] = m.env_offset + j;
+    // Same layout on both sides: environment j of the chunk becomes column s of the pool.
+    for (int t = 0; t <= T; ++t) {
+      std::memcpy(p.obsAt(t, s), &m.obs[(static_cast<std::size_t>(t) * n + j) * od], od * sizeof(float));
+    }
+    for (int t = 0; t < T; ++t) {
+      const std::size_t src = static_cast<std::size_t>(t) * n + j, dst = p.step(t, s);
+      std::memcpy(p.actionAt(t, s), &m.actions[src * ad], ad * sizeof(float));
+      std::memcpy(p.meanAt(t, s), &m.mean[src * ad], ad * sizeof(float));
+      p.log_prob[dst] = m.log_prob[src];
+      p.reward[dst] = m.reward[src];
+      p.terminated[dst] = static_cast<uint8_t>(m.terminated[src]);
+      p.truncated[dst] = static_cast<uint8_t>(m.truncated[src]);
+    }
+    std::memcpy(p.logStdOf(s), m.log_std.data(), ad * sizeof(float));
+  }
+  // Truncations and episodes follow their environment into its slot (if it got one).
+  for (int i = 0; i < m.num_final; ++i) {
+    const int t = m.final_index[i] / n, j = m.final_index[i] % n;
+    const int s = chunk_slots_[j];
+    if (s < 0) continue;
+    p.final_index.push_back(static_cast<int32_t>(p.step(t, s)));
+    const float* obs = &m.final_obs[static_cast<std::size_t>(i) * od];
+    p.final_obs.insert(p.final_obs.end(), obs, obs + od);
+  }
+  for (int i = 0; i < m.num_episodes; ++i) {
+    const int s = chunk_slots_[m.episode_env[i] - m.env_offset];
+    if (s < 0) continue;
+    p.episode_env.push_back(s);
+    p.episode_return.push_back(m.episode_return[i]);
+    p.episode_length.push_back(m.episode_length[i]);
+    p.episode_success.push_back(m.episode_success[i]);
+    // A chunk with other reward terms keeps its returns, not its terms.
+    for (int k = 0; k < K; ++k) {
+      p.episode_term_sums.push_back(terms_match ? m.episode_term_sums[static_cast<std::size_t>(i) * K + k] : 0.0f);
+    }
+  }
+}
+
+bool BatchCollector::take(ppo::RolloutBuffer& out, BatchOrigin* origin) {
+  if (!ready()) return false;
+  const int B = cfg_.num_envs, T = cfg_.horizon, od = cfg_.obs_dim, ad = cfg_.act_dim, C = capacity_;
+  MASA_CHECK(out.numEnvs() == B && out.horizon() == T && out.obsDim() == od && out.actDim() == ad,
+             "rollout buffer is " << out.numEnvs() << " envs x " << out.horizon() << " steps, obs " << out.obsDim()
+                                  << ", act " << out.actDim() << "; the collector's batches are " << B << " x " << T
+                                  << ", obs " << od << ", act " << ad);
+  dropEventsOfFreeSlots();
+  order_.clear();
+  for (int s = 0; s < capacity_; ++s) {
+    if (in_use_[s]) order_.push_back(s);
+  }
+  std::sort(order_.begin(), order_.end(), [&](int a, int b) {
+    return slot_version_[a] != slot_version_[b] ? slot_version_[a] < slot_version_[b]
+                                                : slot_arrival_[a] < slot_arrival_[b];
+  });
+  order_.resize(B);
+
+  const rollout::Rollout& p = pool_;
+  rollout::Rollout& d = out.data();
+  d.allocate(B, T, od, ad, cfg_.term_names);
+  d.clearEvents();
+  if (origin) {
+    origin->env_version.resize(B);
+    origin->env_actor.resize(B);
+    origin->env_index.resize(B);
+  }
+  for (int b = 0; b < B; ++b) {
+    const int s = order_[b];
+    batch_column_[s] = b;
+    for (int t = 0; t <= T; ++t) std::memcpy(d.obsAt(t, b), p.obsAt(t, s), od * sizeof(float));
+    for (int t = 0; t < T; ++t) {
+      const std::size_t src = p.step(t, s), dst = d.step(t, b);
+      std::memcpy(d.actionAt(t, b), p.actionAt(t, s), ad * sizeof(float));
+      std::memcpy(d.meanAt(t, b), p.meanAt(t, s), ad * sizeof(float));
+      d.log_prob[dst] = p.log_prob[src];
+      d.reward[dst] = p.reward[src];
+      d.terminated[dst] = p.terminated[src];
+      d.truncated[dst] = p.truncated[src];
+    }
+    std::memcpy(d.logStdOf(b), p.logStdOf(s), ad * sizeof(float));
+    if (origin) {
+      origin->env_version[b] = slot_version_[s];
+      origin->env_actor[b] = slot_actor_[s];
+      origin->env_index[b] = slot_env_[s];
+    }
+  }
+  // Events of the chosen slots, renumbered to batch columns; truncations in ascending step order.
+  batch_finals_.clear();
+  for (int i = 0; i < p.numFinal(); ++i) {
+    const int s = p.final_index[i] % C, t = p.final_index[i] / C;
+    if (batch_column_[s] >= 0) batch_finals_.emplace_back(static_cast<int32_t>(d.step(t, batch_column_[s])), i);
+  }
+  std::sort(batch_finals_.begin(), batch_finals_.end());
+  for (const auto& [idx, i] : batch_finals_) d.addFinal(idx / B, idx % B, p.finalObs(i));
+  const int K = p.numTerms();
+  for (int i = 0; i < p.numEpisodes(); ++i) {
+    const int b = batch_column_[p.episode_env[i]];
+    if (b >= 0) {
+      d.addEpisode(b, p.episode_return[i], p.episode_length[i], p.episode_success[i],
+                   K > 0 ? &p.episode_term_sums[static_cast<std::size_t>(i) * K] : nullptr);
+    }
+  }
+  for (int b = 0; b < B; ++b) {
+    batch_column_[order_[b]] = -1;
+    release(order_[b]);
+  }
+  ++stats_.batches;
+  return true;
+}
+
+}  // namespace masa::learner

@@ -1,0 +1,60 @@
+// What one update did, and the three places it is told: the lcmt_learner_stats message (lcm-spy,
+// dashboards), a row of metrics.csv, and the progress line on stdout.
+//
+// Counting: one update is one PPO "epoch" in rl_games' sense (one batch collected, then
+// ppo.mini_epochs passes over it in minibatches); ppo.max_epochs is the number of updates. The
+// learner counts updates and nothing else: the policy version it broadcasts is the number of
+// updates its parameters have seen.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/rollout/rollout.hpp"
+#include "learner/intake/drop_reason.hpp"
+#include "learner/ppo/ppo_trainer.hpp"
+#include "masa/lcmt_learner_stats.hpp"
+
+namespace masa::learner {
+
+struct UpdateReport {
+  int64_t epoch = 0;    // this update's index, from 0 (metrics.csv's first column)
+  int64_t version = 0;  // the policy version it produced: epoch + 1
+  int64_t env_steps = 0;
+  double wall_time_s = 0, fps = 0;
+  int num_episodes = 0;
+  double mean_return = 0, mean_length = 0, success_rate = -1;
+  std::vector<double> term_means;
+  ppo::PpoStats ppo;
+  int64_t dropped_chunks = 0;  // by the assembler, every reason (lost included), since the run began
+  int64_t dropped_envs = 0;    // by the collector (stale, overflow), since the run began
+  // The policy mean's evaluation (runner.eval_every): NaN in updates without one.
+  double eval_return = std::nan(""), eval_length = std::nan(""), eval_success = std::nan("");
+  std::vector<double> eval_progress;  // the task's progress figures (Task::progressNames)
+};
+
+// Episode statistics of a batch: mean return, length and reward terms, and the success rate over
+// the episodes that have a success measure (-1 when none has). NaN means when no episode ended.
+void summarizeEpisodes(const rollout::Rollout& batch, UpdateReport& report);
+
+// Names of the reward terms and of the task's progress figures, for the columns.
+struct ReportColumns {
+  std::vector<std::string> term_names;
+  std::vector<std::string> progress_names;
+};
+
+// The stats message of an update: chunk drops by reason, then the collector's own drops.
+masa::lcmt_learner_stats statsMessage(const UpdateReport& report, const ReportColumns& columns, int64_t run_id,
+                                      const DropStats& chunk_drops, int64_t stale_envs, int64_t overflow_envs);
+
+// Appends the update's row to metrics.csv (with the header when the file is new or empty).
+void appendMetricsRow(const std::string& path, const UpdateReport& report, const ReportColumns& columns);
+
+// The progress line (and the evaluation's line when the update had one). `max_updates` <= 0: no
+// total and no ETA; `update_interval_s` is the recent wall time per update.
+void printProgress(const UpdateReport& report, const ReportColumns& columns, int64_t max_updates,
+                   double update_interval_s, int eval_episodes);
+
+}  // namespace masa::learner
