@@ -5,6 +5,7 @@
 // Exit status 0 when a candidate is proposed (with --verify: confirmed), 1 when none, 2 on bad input.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -88,7 +89,9 @@ int main(int argc, char** argv) {
     std::printf("best: %s%s\n", best->label.c_str(), verify ? " (confirmed)" : " (not verified: add --verify)");
     if (!out_file.empty() && !writeFile(out_file, task::foundSpecYaml(found, *best))) return 2;
     if (!task_file.empty() &&
-        !writeFile(task_file, task::foundTaskYaml(found, *best, out_file.empty() ? "<your spec file>" : out_file)))
+        !writeFile(task_file, task::foundTaskYaml(found, *best,
+                                                  out_file.empty() ? "<your spec file>"
+                                                                   : std::filesystem::absolute(out_file).string())))
       return 2;
     return 0;
   } catch (const std::exception& e) {

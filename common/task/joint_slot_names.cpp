@@ -89,11 +89,17 @@ std::vector<std::string> slotNames(const std::vector<std::vector<std::string>>& 
   std::vector<size_t> redo;
   for (size_t s = 0; s < n; ++s)
     if (clashes(s)) redo.push_back(s);
+  // Each fallback renames every slot that still clashes at once, so that slots alike stay named alike.
+  auto fallBack = [&](auto name_of) {
+    std::vector<size_t> still;
+    for (size_t s : redo)
+      if (clashes(s)) still.push_back(s);
+    for (size_t s : still) out[s] = name_of(s);
+    redo = still;
+  };
   for (size_t s : redo) out[s] = identifier(commonCharacters(names_per_slot[s]));
-  for (size_t s : redo)
-    if (clashes(s)) out[s] = identifier(names_per_slot[s][0]);  // limb 0's own name
-  for (size_t s : redo)
-    if (clashes(s)) out[s] = "joint" + std::to_string(s);
+  fallBack([&](size_t s) { return identifier(names_per_slot[s][0]); });  // limb 0's own name
+  fallBack([&](size_t s) { return "joint" + std::to_string(s); });
   return out;
 }
 
