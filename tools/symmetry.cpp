@@ -87,12 +87,16 @@ int main(int argc, char** argv) {
       return 1;
     }
     std::printf("best: %s%s\n", best->label.c_str(), verify ? " (confirmed)" : " (not verified: add --verify)");
-    if (!out_file.empty() && !writeFile(out_file, task::foundSpecYaml(found, *best))) return 2;
+    if (!out_file.empty()) {
+      if (!writeFile(out_file, task::foundSpecYaml(found, *best))) return 2;
+      std::printf("spec written to %s\n", out_file.c_str());
+    }
     if (!task_file.empty() &&
         !writeFile(task_file, task::foundTaskYaml(found, *best,
                                                   out_file.empty() ? "<your spec file>"
                                                                    : std::filesystem::absolute(out_file).string())))
       return 2;
+    if (!task_file.empty()) std::printf("YAML task written to %s\n", task_file.c_str());
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "masa_symmetry: " << e.what() << "\n";
