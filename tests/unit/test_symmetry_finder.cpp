@@ -154,6 +154,22 @@ TEST(SymmetryFinder, ProposesC4ForTheWalkerWithUnnamedActuatorsAndItsYamlTaskObs
   EXPECT_TRUE(check.confirmed) << check.error << check.report.summary();
 }
 
+// What --task-out writes is a task config: its env builds the YAML task over the spec --out writes.
+TEST(SymmetryFinder, TheWrittenTaskConfigBuildsAYamlTaskOverTheWrittenSpec) {
+  const auto found = findSymmetries(kSource + "/tasks/humanoid_tightrope/model.xml");
+  const SymmetryCandidate& best = *found.proposed().front();
+  const std::string spec_path = writeTemp("found_humanoid.yaml", foundSpecYaml(found, best));
+  const YAML::Node config = YAML::Load(foundTaskYaml(found, best, spec_path));
+  EXPECT_EQ(config["spec"].as<std::string>(), spec_path);
+  EXPECT_EQ(config["env"]["task_code"].as<std::string>(), "yaml");
+  const auto spec = sym::SymmetrySpec::load(spec_path);
+  const TaskFactory factory("found_humanoid", spec, config["env"], {}, "test");
+  const auto t = factory.create();
+  // The base (height, velocities, quaternion: 11), the abdomen (9) and 2 limbs of 27, as the shipped humanoid.
+  EXPECT_EQ(t->obsDim(), 1 + 3 + 3 + 1 + 3 + 9 + 2 * 27);
+  EXPECT_EQ(spec.actDim(), 21);
+}
+
 // Legs at irregular angles: no mirror, no rotation maps the joints onto each other.
 const char* kLopsidedModel = R"(<mujoco model="lopsided">
   <worldbody>
