@@ -109,10 +109,14 @@ Actor::~Actor() = default;
 void Actor::onParams(const masa::lcmt_policy_params& m) {
   if (m.run_id != options_.run_id) return;  // another run on the same network
   const int64_t newest = std::max(version_, pending_version_);
-  if (m.version == newest) last_learner_s_ = nowSeconds();  // the learner's periodic repeat: it is alive
-  if (m.version <= newest) return;  // the learner repeats its latest parameters periodically
+  if (m.version == newest) {  // the learner's periodic repeat: it is alive, and agrees with us
+    last_learner_s_ = nowSeconds();
+    behind_in_a_row_ = 0;
+    return;
+  }
+  const bool behind = m.version < newest;
   auto reject = [&](const std::string& why) { rejectParams(m.version, why); };
-  if (m.version - std::max<int64_t>(newest, 0) > options_.max_version_step)
+  if (!behind && m.version - std::max<int64_t>(newest, 0) > options_.max_version_step)
     return reject("more than " + std::to_string(options_.max_version_step) + " versions ahead of " +
                   std::to_string(std::max<int64_t>(newest, 0)));
   if (m.task != config_.task) return reject("task '" + m.task + "', this actor runs '" + config_.task + "'");
@@ -133,6 +137,20 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
   for (int d = 0; d < m.obs_dim; ++d)
     if (!std::isfinite(m.obs_mean[d]) || !std::isfinite(m.obs_std[d]) || !(m.obs_std[d] > 0.0f))
       return reject("bad normalizer entry " + std::to_string(d));
+  if (behind) {
+    // Usually a late copy of older parameters: ignored. But when valid parameters below ours keep
+    // coming, with none at our version in between, ours were never the learner's: on a network
+    // without authentication a forged or corrupted message with a plausible version got in, and
+    // the learner drops every chunk acted with it (future_version). Taking the learner's version
+    // back ends that; a replay that pushes us back costs stale chunks until the next update.
+    if (++behind_in_a_row_ < options_.behind_repeats_to_take_back) return;
+    std::fprintf(stderr,
+                 "masa_actor %d: taking parameters version %lld back from %lld: %d valid messages in a row below "
+                 "this actor's version, none at it (was %lld forged or corrupted? use the run key)\n",
+                 options_.actor_id, static_cast<long long>(m.version), static_cast<long long>(newest),
+                 behind_in_a_row_, static_cast<long long>(newest));
+  }
+  behind_in_a_row_ = 0;
   std::copy(m.params.begin(), m.params.end(), pending_params_.begin());
   pending_count_ = n;
   if (m.obs_dim > 0) {

@@ -70,6 +70,9 @@ struct ActorOptions {
   // actor's (of 0 before the first) is rejected. No run makes a million updates; a forged or fuzzed
   // version (2^51) would otherwise make the actor ignore every real update after it.
   int64_t max_version_step = 1'000'000;
+  // Valid parameters of a version below the actor's, this many in a row with none at its version,
+  // are taken (the actor's version was not the learner's; see Actor::onParams).
+  int behind_repeats_to_take_back = 3;
   // Rejected parameter messages are warned about at most once per this interval (the learner
   // repeats its parameters, so a mismatch would otherwise print a line per repetition).
   double reject_warning_interval_s = 5.0;
@@ -106,6 +109,7 @@ class Actor {
   int64_t chunksPublished() const { return chunks_published_; }
   int64_t chunksDropped() const { return chunks_dropped_; }  // by drop_chunks_percent
   int64_t paramsRejected() const { return params_rejected_; }
+  const transport::Transport& transport() const { return *transport_; }
   const rollout::Rollout& lastRollout() const { return rollout_; }
   int numEnvs() const { return num_envs_; }
   model::ActorCritic<float>& model() { return *model_; }
@@ -159,6 +163,7 @@ class Actor {
   // Nothing of a rejected message is kept but these counts: it cannot change what comes after it.
   int64_t params_rejected_ = 0;
   int64_t rejects_since_warning_ = 0;
+  int behind_in_a_row_ = 0;  // valid parameters below our version since the last at it
   double last_reject_warning_s_ = -1e300;
 
   int64_t rollouts_sent_ = 0;

@@ -104,6 +104,8 @@ int main(int argc, char** argv) {
     if (opt.drop_chunks_percent > 0)
       std::fprintf(stderr, ", %lld thrown away by fault injection", static_cast<long long>(actor.chunksDropped()));
     std::fprintf(stderr, "\n");
+    std::fprintf(stderr, "masa_actor %d: parameter messages refused after decoding %lld; rejected before decoding: %s\n",
+                 opt.actor_id, static_cast<long long>(actor.paramsRejected()), actor.transport().rejectSummary().c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_actor: %s\n", e.what());
     return 2;

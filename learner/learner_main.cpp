@@ -107,6 +107,8 @@ int main(int argc, char** argv) {
       if (drops[reason] > 0) std::cout << ", " << masa::learner::dropReasonName(reason) << " " << drops[reason];
     }
     std::cout << std::endl;
+    std::cout << "masa_learner: other messages rejected before decoding: " << learner.transport().rejectSummary()
+              << std::endl;
   } catch (const std::exception& e) {
     std::cerr << "masa_learner: " << e.what() << "\n";
     return 2;

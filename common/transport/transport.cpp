@@ -107,6 +107,22 @@ WireRejects Transport::rejected(const std::string& channel) const {
   return it == rejects_.end() ? WireRejects{} : it->second.count;
 }
 
+std::string Transport::rejectSummary() const {
+  std::string out;
+  for (const auto& [channel, r] : rejects_) {
+    std::string reasons;
+    for (int v = 0; v < kNumWireVerdicts; ++v) {
+      if (r.count[v] == 0) continue;
+      if (!reasons.empty()) reasons += ", ";
+      reasons += std::string(wireVerdictName(static_cast<WireVerdict>(v))) + " " + std::to_string(r.count[v]);
+    }
+    if (reasons.empty()) continue;
+    if (!out.empty()) out += "; ";
+    out += channel + ": " + reasons;
+  }
+  return out.empty() ? "none" : out;
+}
+
 void Transport::countRejected(const std::string& channel, WireVerdict why) {
   ++decode_errors_;
   ChannelRejects& r = rejects_[channel];

@@ -91,6 +91,9 @@ class Transport {
   // on all channels, and on one per reason.
   int64_t decodeErrors() const { return decode_errors_; }
   WireRejects rejected(const std::string& channel) const;
+  // Every channel's rejects by reason in one line ("MASA_POLICY: malformed 12, unauthenticated 3;
+  // ..."), or "none": what a process says when it stops.
+  std::string rejectSummary() const;
 
  private:
   struct Sub {

@@ -304,6 +304,44 @@ TEST(ActorRollouts, AVersionFarAheadOfTheActorsIsRejectedAndTheRealNextVersionIs
   EXPECT_EQ(fresh.policyVersion(), 3);
 }
 
+// Without authentication, a corrupted or forged message with a valid body and a plausible version
+// ahead of the learner's was taken, and the actor then ignored the learner's own parameters (all
+// "older") for good while the learner dropped its chunks as future_version: a live fuzz run
+// stalled this way. The learner's repeats below the actor's version now take it back.
+TEST(ActorRollouts, AVersionTheLearnerNeverPublishedIsGivenUpWhenTheLearnerKeepsPublishingItsOwn) {
+  const auto rc = smallConfig(4);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  actor::Actor actor(rc, options(1, -1), &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(7));
+  ASSERT_TRUE(actor.pollParams(10));
+  bus.publish(transport::kPolicyChannel, learner.message(985, 0.25f));  // a bit flip in the version
+  actor.pollParams(10);
+  ASSERT_TRUE(actor.collectAndPublish());
+  ASSERT_EQ(actor.policyVersion(), 985);
+  // One or two late copies of older parameters are still ignored ...
+  bus.publish(transport::kPolicyChannel, learner.message(7));
+  bus.publish(transport::kPolicyChannel, learner.message(7));
+  actor.pollParams(10);
+  ASSERT_TRUE(actor.collectAndPublish());
+  EXPECT_EQ(actor.policyVersion(), 985);
+  // ... the third in a row, with none at the actor's version, is the learner's: taken back.
+  bus.publish(transport::kPolicyChannel, learner.message(7));
+  actor.pollParams(10);
+  ASSERT_TRUE(actor.collectAndPublish());
+  EXPECT_EQ(actor.policyVersion(), 7);
+  EXPECT_EQ(actor.model().params().values().head(3), learner.model.params().values().head(3));
+  // A repeat at the actor's version in between resets the count.
+  bus.publish(transport::kPolicyChannel, learner.message(985, 0.25f));
+  actor.pollParams(10);
+  ASSERT_TRUE(actor.collectAndPublish());
+  ASSERT_EQ(actor.policyVersion(), 985);
+  for (int version : {7, 7, 985, 7, 7}) bus.publish(transport::kPolicyChannel, learner.message(version, version == 985 ? 0.25f : 0.0f));
+  actor.pollParams(10);
+  ASSERT_TRUE(actor.collectAndPublish());
+  EXPECT_EQ(actor.policyVersion(), 985);
+}
+
 TEST(ActorRollouts, WholeModelParametersAreAcceptedAsWellAsThePolicyPrefix) {
   const auto rc = smallConfig(4);
   transport::Transport bus("memq://");
