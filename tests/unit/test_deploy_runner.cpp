@@ -19,6 +19,7 @@
 #include "common/policy/policy_file.hpp"
 #include "deploy/runner/deploy_config.hpp"
 #include "deploy/runner/policy_runner.hpp"
+#include "deploy/runner/realtime.hpp"
 
 namespace masa::deploy {
 namespace {
@@ -433,6 +434,20 @@ TEST(DeployRunner, WarmUpChangesNoCommand) {
     compared += a.mode == static_cast<int>(Mode::kPolicy);
   }
   EXPECT_GT(compared, 60);
+}
+
+// realtime: settings the system refuses are said, not fatal; bad values are config errors.
+TEST(DeployRealtime, RefusedSettingsAreSaidAndBadValuesAreErrors) {
+  EXPECT_EQ(applyRealtime(RealtimeSettings{}), "normal scheduling");
+  RealtimeSettings no_such_core;
+  no_such_core.cpu = 4000;  // sched_setaffinity fails; this process keeps its cores
+  EXPECT_NE(applyRealtime(no_such_core).find("NOT pinned to core 4000"), std::string::npos);
+  EXPECT_THROW(loadDeployConfig("", {"realtime.priority=100"}), ConfigError);
+  EXPECT_THROW(loadDeployConfig("", {"realtime.cpu=1.5"}), ConfigError);
+  EXPECT_THROW(loadDeployConfig("", {"realtime.busy_poll_us=-1"}), ConfigError);
+  const DeployConfig c = loadDeployConfig("", {"realtime.priority=50", "realtime.warm_up_us=1000"});
+  EXPECT_EQ(c.realtime.priority, 50);
+  EXPECT_EQ(c.warm_up_us, 1000);
 }
 
 TEST(DeployConfig, UnknownKeyAndBadValueNameTheKey) {
