@@ -75,7 +75,7 @@ class PolicyRunner {
   int64_t nextCommandDueUs() const { return started_ ? next_due_us_ : INT64_MAX; }
   // Runs the observation and the policy on the newest state and throws the result away: called
   // shortly before a command is due, it brings the network's weights back into the cache that other
-  // processes evicted since the last command (under load the step then takes 10 us, not 50).
+  // processes evicted since the last command (measured under load: step p50 32 -> 12-17 us).
   // Changes no command. Nothing allocates.
   void warmUp();
   // Switches to the safe command (latched) now, saying why (e.g. the operator stopped).
