@@ -1,7 +1,11 @@
 // A robot's state stream for bench/deploy_latency.sh: publishes lcmt_robot_state of the A1 standing
 // on its beam (the task's reset pose; utime = the publication time) at --rate-hz and measures, for
 // every command that answers one of these states, the round trip from the state's publication to
-// the command's arrival. Prints p50 / p99 / max and the command count. A plain program.
+// the command's arrival, and its two legs split at the command's utime (stamped by the runner just
+// before it publishes; one clock, as both run on this machine): state published -> command
+// stamped (LCM's delivery and the runner's wakeups, observation, inference) and command stamped ->
+// received (the runner's publish, the delivery back and this program's wakeups). Prints p50 / p99
+// / max and the command count. A plain program.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -48,8 +52,10 @@ int main(int argc, char** argv) {
   s.base_qw = q[3], s.base_qx = q[4], s.base_qy = q[5], s.base_qz = q[6];
 
   transport::Transport lcm("");
-  std::vector<int64_t> rtt;
+  std::vector<int64_t> rtt, there, back;
   rtt.reserve(1 << 20);
+  there.reserve(1 << 20);
+  back.reserve(1 << 20);
   int64_t policy_commands = 0;
   masa::lcmt_robot_command c{};
   lcm.subscribeRaw(transport::kRobotCommandChannel, [&](const void* data, int size) {
@@ -57,6 +63,8 @@ int main(int argc, char** argv) {
     if (transport::decodeChecked(data, size, c) != transport::WireVerdict::kOk || c.state_utime <= 0) return;
     if (c.mode == 1) ++policy_commands;
     rtt.push_back(now - c.state_utime);
+    there.push_back(c.utime - c.state_utime);
+    back.push_back(now - c.utime);
   });
   const auto period = std::chrono::duration<double>(1.0 / rate_hz);
   const auto t0 = std::chrono::steady_clock::now();
@@ -70,11 +78,17 @@ int main(int argc, char** argv) {
     while (std::chrono::steady_clock::now() < next) lcm.handleTimeout(1);
     lcm.drain();
   }
-  std::sort(rtt.begin(), rtt.end());
-  const auto at = [&](double p) { return rtt.empty() ? 0 : rtt[std::min<size_t>(rtt.size() - 1, p * rtt.size())]; };
+  for (auto* v : {&rtt, &there, &back}) std::sort(v->begin(), v->end());
+  const auto pct = [](const std::vector<int64_t>& v, double p) {
+    return static_cast<long long>(v.empty() ? 0 : v[std::min<size_t>(v.size() - 1, p * v.size())]);
+  };
+  const auto at = [&](double p) { return pct(rtt, p); };
   std::printf("deploy_state_source: %lld states at %.0f Hz; %zu commands answered a state (%lld in policy mode); "
               "round trip state published -> command received: p50 %lld us, p99 %lld us, max %lld us\n",
               static_cast<long long>(sent), rate_hz, rtt.size(), static_cast<long long>(policy_commands),
               static_cast<long long>(at(0.5)), static_cast<long long>(at(0.99)), static_cast<long long>(rtt.empty() ? 0 : rtt.back()));
+  std::printf("deploy_state_source: state published -> command stamped by the runner p50 %lld / p99 %lld us; "
+              "command stamped -> received here p50 %lld / p99 %lld us\n",
+              pct(there, 0.5), pct(there, 0.99), pct(back, 0.5), pct(back, 0.99));
   return 0;
 }

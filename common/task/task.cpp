@@ -223,6 +223,27 @@ StepOutcome Task::step(const float* action) {
   return out;
 }
 
+bool Task::motorJointCommand(const double* action, const double* pose, double* position, double* velocity,
+                             double* torque_ff, double* kp, double* kd) const {
+  const mjModel* m = model_->get();
+  for (int k = 0; k < actDim(); ++k) {
+    const int a = action_actuator_[k];
+    const bool plain_motor = m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_dyntype[a] == mjDYN_NONE &&
+                             m->actuator_gaintype[a] == mjGAIN_FIXED && m->actuator_biastype[a] == mjBIAS_NONE;
+    if (!plain_motor || action_joint_[k] < 0) return false;
+    const double u = std::clamp(action[k], -1.0, 1.0);
+    double ctrl = u;  // as applyAction: [-1, 1] onto the ctrlrange
+    if (m->actuator_ctrllimited[a]) {
+      const double lo = m->actuator_ctrlrange[2 * a], hi = m->actuator_ctrlrange[2 * a + 1];
+      ctrl = 0.5 * (lo + hi) + 0.5 * (hi - lo) * u;
+    }
+    torque_ff[k] = m->actuator_gear[6 * a] * m->actuator_gainprm[mjNGAIN * a] * ctrl;
+    position[k] = pose[k];
+    velocity[k] = kp[k] = kd[k] = 0.0;
+  }
+  return true;
+}
+
 double Task::jointPower() const {
   const mjModel* m = model_->get();
   double p = 0.0;

@@ -163,6 +163,12 @@ class Task {
   // (the Humanoid's). Physical power |torque * qdot| would be gear times larger and swamp the
   // other terms at the paper's weights.
   double jointPower() const;
+  // For a task that drives plain joint motors through the default applyAction: the joint command
+  // a torque-controlled robot runs, torque_ff = the motor's torque for `action`, kp = kd = 0, and
+  // `pose` (the task's start pose, action order) as position targets, which only the runner's
+  // calibration ramp and limits read. False when an actuator is not such a motor.
+  bool motorJointCommand(const double* action, const double* pose, double* position, double* velocity,
+                         double* torque_ff, double* kp, double* kd) const;
 
   std::shared_ptr<const MujocoModel> model_;
   mjData* data_ = nullptr;

@@ -121,6 +121,37 @@ DeployConfig loadDeployConfig(const std::string& file, const std::vector<std::st
   c.hold_kd = r.number("safe.hold_kd", 0.0, 1e6);
   c.max_roll = r.number("emergency.max_roll", 0.0, 3.2, true);
   c.max_pitch = r.number("emergency.max_pitch", 0.0, 3.2, true);
+  const std::string response = r.get<std::string>("emergency.response");
+  if (response == "damping") {
+    c.emergency_response = EmergencyResponse::kDamping;
+  } else if (response == "crouch") {
+    c.emergency_response = EmergencyResponse::kCrouch;
+  } else {
+    throw ConfigError(r.originOf("emergency.response"), "emergency.response",
+                      "must be damping or crouch, got '" + response + "'");
+  }
+  c.crouch_pose = r.get<std::vector<double>>("emergency.crouch_pose");
+  for (double q : c.crouch_pose)
+    if (!std::isfinite(q)) throw ConfigError(r.originOf("emergency.crouch_pose"), "emergency.crouch_pose", "not finite");
+  if (c.emergency_response == EmergencyResponse::kCrouch && c.crouch_pose.empty())
+    throw ConfigError(r.originOf("emergency.response"), "emergency.crouch_pose",
+                      "response crouch needs a crouch pose (one angle per joint, action order)");
+  c.crouch_max_rate = r.number("emergency.crouch_max_rate", 0.0, 100.0, true);
+  // The limits clamp every command's gains: a crouch gain above them would be silently weaker.
+  const bool crouch = c.emergency_response == EmergencyResponse::kCrouch;
+  c.crouch_kp = r.number("emergency.crouch_kp", 0.0, crouch ? c.max_kp : 1e6);
+  c.crouch_kd = r.number("emergency.crouch_kd", 0.0, crouch ? c.max_kd : 1e6);
+  const auto integer = [&r](const std::string& path, int lo, int hi) {
+    const int v = r.get<int>(path);  // "1.5" is not a valid value
+    if (v < lo || v > hi)
+      throw ConfigError(r.originOf(path), path, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(v));
+    return v;
+  };
+  c.realtime.cpu = integer("realtime.cpu", -1, 4095);
+  c.realtime.priority = integer("realtime.priority", 0, 99);
+  c.realtime.lock_memory = r.get<bool>("realtime.lock_memory");
+  c.busy_poll_us = integer("realtime.busy_poll_us", 0, 1000000);
+  c.warm_up_us = integer("realtime.warm_up_us", 0, 1000000);
   return c;
 }
 

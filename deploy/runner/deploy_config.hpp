@@ -6,9 +6,13 @@
 #include <string>
 #include <vector>
 
+#include "deploy/runner/realtime.hpp"
+
 namespace masa::deploy {
 
 enum class SafeMode { kDamping, kHold };
+// What the emergency stop (orientation limit) commands.
+enum class EmergencyResponse { kDamping, kCrouch };
 
 struct DeployConfig {
   std::string lcm_url;
@@ -27,6 +31,13 @@ struct DeployConfig {
   double damping_kd = 2.0;
   double hold_kp = 40.0, hold_kd = 1.0;
   double max_roll = 0.8, max_pitch = 0.8;  // rad
+  EmergencyResponse emergency_response = EmergencyResponse::kDamping;
+  std::vector<double> crouch_pose;  // rad per joint, action order (its size is checked against the robot)
+  double crouch_max_rate = 1.0;     // rad/s
+  double crouch_kp = 40.0, crouch_kd = 1.0;
+  RealtimeSettings realtime;
+  int busy_poll_us = 0;  // spin this long before a command is due (0: sleep until a state arrives)
+  int warm_up_us = 0;    // PolicyRunner::warmUp() this long before a command is due (0: never)
 };
 
 // configs/deploy/defaults.yaml of this source tree (or $MASA_CONFIGS/deploy/defaults.yaml).

@@ -76,6 +76,7 @@ PolicyRunner::PolicyRunner(policy::LoadedPolicy& policy, const DeployConfig& con
     nominal_kp_[k] = std::clamp(nominal_kp_[k], 0.0, cfg_.max_kp);
     nominal_kd_[k] = std::clamp(nominal_kd_[k], 0.0, cfg_.max_kd);
   }
+  if (cfg_.emergency_response == EmergencyResponse::kCrouch) checkCrouchPose();
   const double period_s = cfg_.control_rate_hz > 0 ? 1.0 / cfg_.control_rate_hz : task_->controlTimestep();
   period_us_ = std::max<int64_t>(1, std::llround(period_s * 1e6));
   stale_us_ = std::max<int64_t>(1, std::llround(cfg_.stale_after_s * 1e6));
@@ -86,6 +87,21 @@ PolicyRunner::PolicyRunner(policy::LoadedPolicy& policy, const DeployConfig& con
 }
 
 PolicyRunner::~PolicyRunner() = default;
+
+// A crouch pose the limits would clamp is not the pose the config promises: refuse it.
+void PolicyRunner::checkCrouchPose() const {
+  if (static_cast<int>(cfg_.crouch_pose.size()) != n_)
+    throw std::runtime_error("emergency.crouch_pose has " + std::to_string(cfg_.crouch_pose.size()) +
+                             " values; task " + task_->name() + "'s robot has " + std::to_string(n_) + " joints");
+  for (int k = 0; k < n_; ++k) {
+    const double q = cfg_.crouch_pose[k];
+    if (q >= lower_[k] && q <= upper_[k]) continue;
+    const char* name = mj_id2name(task_->model(), mjOBJ_JOINT, task_->jointOfAction(k));
+    throw std::runtime_error("emergency.crouch_pose: joint " + std::to_string(k) + " (" + (name ? name : "?") + ") at " +
+                             std::to_string(q) + " rad is outside [" + std::to_string(lower_[k]) + ", " +
+                             std::to_string(upper_[k]) + "] (its range less limits.position_margin)");
+  }
+}
 
 masa::lcmt_robot_command PolicyRunner::makeCommand() const {
   masa::lcmt_robot_command c{};
@@ -148,6 +164,9 @@ void PolicyRunner::trip(Mode m, std::string why) {
   mode_ = m;
   reason_ = std::move(why);
   for (int k = 0; k < n_; ++k) hold_pose_[k] = std::clamp(q_[k], lower_[k], upper_[k]);
+  // The crouch ramp starts where the robot is, not at the last target: after a fall the two differ
+  // and a jump to the old target is what the ramp is there to avoid.
+  if (crouching()) prev_target_ = hold_pose_;
 }
 
 void PolicyRunner::stop(Mode safe, const std::string& why) {
@@ -194,7 +213,7 @@ bool PolicyRunner::poll(int64_t now_us, masa::lcmt_robot_command& cmd) {
   answered_rx_us_ = 0;
   answered_utime_ = 0;
   if (isLatched(mode_)) {
-    safeTargets();
+    safeTargets(std::min(now_us - last_cmd_us_, period_us_) * 1e-6);
   } else {
     if (!(state_fresh_ && state_rx_us_ >= next_due_us_)) return false;  // wait for a fresh state
     const double dt = std::min(now_us - last_cmd_us_, period_us_) * 1e-6;
@@ -205,7 +224,7 @@ bool PolicyRunner::poll(int64_t now_us, masa::lcmt_robot_command& cmd) {
       calibrationTargets(dt);
     } else if (!policyTargets(dt)) {
       trip(cfg_.safe_mode == SafeMode::kHold ? Mode::kHold : Mode::kDamping, "policy output not finite");
-      safeTargets();
+      safeTargets(dt);
     }
   }
   finishCommand(now_us, cmd);
@@ -259,7 +278,27 @@ bool PolicyRunner::policyTargets(double dt_s) {
   return allFinite(target_) && allFinite(vel_) && allFinite(tau_) && allFinite(kp_) && allFinite(kd_);
 }
 
-void PolicyRunner::safeTargets() {
+void PolicyRunner::warmUp() {
+  if (mode_ != Mode::kPolicy || !state_finite_) return;
+  // The same calls as policyTargets(): the task's data is rewritten from the state on every step,
+  // so the next command is the same with or without this.
+  task_->setMeasuredState(q_.data(), qd_.data(), has_base_ ? base_pose_ : nullptr, has_base_ ? base_vel_ : nullptr,
+                          last_action_.data());
+  task_->observe(obs_.data());
+  model_->actMean(obs_);
+}
+
+void PolicyRunner::safeTargets(double dt_s) {
+  if (crouching()) {
+    const double step = cfg_.crouch_max_rate * dt_s;
+    for (int k = 0; k < n_; ++k) {
+      target_[k] = prev_target_[k] + std::clamp(cfg_.crouch_pose[k] - prev_target_[k], -step, step);
+      vel_[k] = tau_[k] = 0.0;
+      kp_[k] = cfg_.crouch_kp;
+      kd_[k] = cfg_.crouch_kd;
+    }
+    return;
+  }
   const bool hold = mode_ == Mode::kHold;
   for (int k = 0; k < n_; ++k) {
     target_[k] = hold_pose_[k];

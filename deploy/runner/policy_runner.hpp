@@ -9,7 +9,10 @@
 //   policy      : observation from the state through the task's own observation code
 //                 (Task::setMeasuredState + Task::observe), the policy mean, the task's joint
 //                 command (Task::jointCommand), then the limits;
-//   damping / hold (watchdog), emergency stop: latched until restart.
+//   damping / hold (watchdog), emergency stop: latched until restart. The emergency stop (base
+//                 roll or pitch beyond its limit) damps, or with emergency.response crouch ramps
+//                 the targets from the measured pose to emergency.crouch_pose at most
+//                 crouch_max_rate and holds it there (walk-these-ways' fall response).
 // Every command, in every mode, passes the limits: targets inside the model's joint range less a
 // margin, at most max_target_rate per second away from the previous target (policy mode), gains
 // and feed-forward torques within their bounds.
@@ -18,6 +21,7 @@
 // a non-finite state (or policy output) gives it at once. Nothing allocates after construction.
 #pragma once
 
+#include <climits>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -53,6 +57,8 @@ class PolicyRunner {
   const std::vector<double>& lowerLimit() const { return lower_; }
   const std::vector<double>& upperLimit() const { return upper_; }
   const std::vector<double>& torqueLimit() const { return torque_limit_; }
+  // In the emergency stop with the crouch response: the targets ramp to the crouch pose.
+  bool crouching() const { return mode_ == Mode::kEmergencyStop && cfg_.emergency_response == EmergencyResponse::kCrouch; }
   // Why the last mode change happened ("" before any): for the log.
   const std::string& reason() const { return reason_; }
 
@@ -64,6 +70,14 @@ class PolicyRunner {
   bool poll(int64_t now_us, masa::lcmt_robot_command& cmd);
   // The latest time poll() must be called again (for the LCM wait); INT64_MAX: only on a state.
   int64_t nextDeadline(int64_t now_us) const;
+  // When the next command is due (it answers the first state received from then on); INT64_MAX
+  // before the first state.
+  int64_t nextCommandDueUs() const { return started_ ? next_due_us_ : INT64_MAX; }
+  // Runs the observation and the policy on the newest state and throws the result away: called
+  // shortly before a command is due, it brings the network's weights back into the cache that other
+  // processes evicted since the last command (measured under load: step p50 32 -> 12-17 us).
+  // Changes no command. Nothing allocates.
+  void warmUp();
   // Switches to the safe command (latched) now, saying why (e.g. the operator stopped).
   void stop(Mode safe, const std::string& why);
   // A command message sized for this robot.
@@ -79,7 +93,8 @@ class PolicyRunner {
   void trip(Mode m, std::string why);
   void calibrationTargets(double dt_s);
   bool policyTargets(double dt_s);
-  void safeTargets();
+  void safeTargets(double dt_s);
+  void checkCrouchPose() const;
   void finishCommand(int64_t now_us, masa::lcmt_robot_command& cmd);
   bool orientationBeyondLimit(std::string& why) const;
 

@@ -13,6 +13,7 @@
 #include <csignal>
 #include <cstdio>
 #include <random>
+#include <sched.h>
 #include <thread>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "common/transport/transport.hpp"
 #include "deploy/runner/deploy_config.hpp"
 #include "deploy/runner/policy_runner.hpp"
+#include "deploy/runner/realtime.hpp"
 
 using namespace masa;
 
@@ -55,6 +57,46 @@ class LatencyHistogram {
   int64_t count_ = 0;
 };
 
+// State received (the handler) -> command published, and its parts: until poll() starts (the rest
+// of the LCM dispatch, the loop), poll() (observation, inference, limits), publish().
+struct CommandLatency {
+  LatencyHistogram total, to_poll, in_poll, in_publish;
+  void add(int64_t rx, int64_t polled, int64_t computed, int64_t out) {
+    total.add(out - rx);
+    to_poll.add(polled - rx);
+    in_poll.add(computed - polled);
+    in_publish.add(out - computed);
+  }
+};
+
+// Waits for the loop's next piece of work: a state, or a command's deadline; with the realtime
+// settings, also the warm-up before a command (realtime.warm_up_us) and, near a command, no sleep
+// at all (realtime.busy_poll_us), so that no thread wakeup stands between the state and the
+// command; sched_yield lets LCM's receive thread (same core, same priority) run meanwhile.
+void waitForWork(transport::Transport& lcm, deploy::PolicyRunner& runner, const deploy::DeployConfig& cfg,
+                 int64_t& warmed_for) {
+  const int64_t now = steadyMicros();
+  int64_t wait_us = std::clamp<int64_t>(runner.nextDeadline(now) - now, 0, 20000);
+  const int64_t due = runner.nextCommandDueUs();
+  if (cfg.warm_up_us > 0 && due != warmed_for && due != INT64_MAX) {
+    if (now >= due - cfg.warm_up_us) {
+      runner.warmUp();
+      warmed_for = due;
+      return;
+    }
+    wait_us = std::min(wait_us, due - cfg.warm_up_us - now);
+  }
+  if (cfg.busy_poll_us > 0) {
+    const int64_t spin_from = due - cfg.busy_poll_us;
+    if (now >= spin_from) {
+      if (lcm.handleTimeout(0) > 0) lcm.drain(); else sched_yield();
+      return;
+    }
+    wait_us = std::min(wait_us, spin_from - now);
+  }
+  if (lcm.handleTimeout(static_cast<int>((wait_us + 999) / 1000)) > 0) lcm.drain();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -84,13 +126,18 @@ int main(int argc, char** argv) {
     std::random_device rd;
     const int64_t runner_id = static_cast<int64_t>((uint64_t{rd()} << 32) ^ rd() ^ steadyMicros()) & INT64_MAX;
     deploy::PolicyRunner runner(lp, cfg, runner_id);
+    const std::string scheduling = deploy::applyRealtime(cfg.realtime);  // before LCM starts its receive thread
     transport::Transport lcm(url.empty() ? cfg.lcm_url : url);
     std::fprintf(stderr,
                  "masa_deploy: task %s, method %s (equivariance error %.1e), %d joints, %.1f Hz, watchdog %.0f ms "
-                 "(safe command within %.0f ms), state %s, commands %s, id %lld\n",
+                 "(safe command within %.0f ms), state %s, commands %s, id %lld; %s%s\n",
                  lp.config.task.c_str(), model::methodName(lp.config.method).c_str(), sym_error, runner.numJoints(),
                  1.0 / runner.periodS(), cfg.stale_after_s * 1e3, runner.watchdogBoundS() * 1e3, cfg.state_channel.c_str(),
-                 cfg.command_channel.c_str(), static_cast<long long>(runner_id));
+                 cfg.command_channel.c_str(), static_cast<long long>(runner_id), scheduling.c_str(),
+                 (std::string(cfg.busy_poll_us > 0 ? "; busy poll " + std::to_string(cfg.busy_poll_us) + " us" : "") +
+                  (cfg.warm_up_us > 0 ? "; warm-up " + std::to_string(cfg.warm_up_us) + " us" : "") +
+                  (cfg.busy_poll_us > 0 || cfg.warm_up_us > 0 ? " before each command" : ""))
+                     .c_str());
 
     // Commands of other runners on our channel: the start guard, and a warning later.
     masa::lcmt_robot_command heard = runner.makeCommand();
@@ -126,11 +173,11 @@ int main(int argc, char** argv) {
                  cfg.start_guard_s, cfg.state_channel.c_str());
 
     masa::lcmt_robot_command cmd = runner.makeCommand();
-    LatencyHistogram latency;
+    CommandLatency latency;
     deploy::Mode shown = deploy::Mode::kCalibrating;
     bool announced = false;
     const int64_t t0 = steadyMicros();
-    int64_t next_status = t0 + 1000000, published = 0;
+    int64_t next_status = t0 + 1000000, published = 0, warmed_for = -1;
     int exit_code = 0;
     for (;;) {
       const int64_t now = steadyMicros();
@@ -142,9 +189,10 @@ int main(int argc, char** argv) {
                     g_stop ? "stopped by signal" : end_by_steps ? "policy step limit reached" : "--duration reached");
       }
       if (runner.poll(now, cmd)) {
+        const int64_t computed = steadyMicros();
         lcm.publish(cfg.command_channel, cmd);
         ++published;
-        if (runner.lastAnsweredRxUs() > 0) latency.add(steadyMicros() - runner.lastAnsweredRxUs());
+        if (runner.lastAnsweredRxUs() > 0) latency.add(runner.lastAnsweredRxUs(), now, computed, steadyMicros());
         if (!announced || runner.mode() != shown) {
           std::fprintf(stderr, "masa_deploy: %s: %s\n", deploy::modeName(runner.mode()), runner.reason().c_str());
           shown = runner.mode();
@@ -168,19 +216,21 @@ int main(int argc, char** argv) {
                      static_cast<long long>(published), static_cast<long long>(runner.policySteps()));
         next_status += 1000000;
       }
-      const int64_t deadline = runner.nextDeadline(steadyMicros());
-      const int64_t wait_us = std::clamp<int64_t>(deadline - steadyMicros(), 0, 20000);
-      if (lcm.handleTimeout(static_cast<int>((wait_us + 999) / 1000)) > 0) lcm.drain();
+      waitForWork(lcm, runner, cfg, warmed_for);
     }
     std::fprintf(stderr,
                  "masa_deploy: stopped in mode %s (%s); %lld states (%lld ignored, %lld rejected by the wire guard), "
                  "%lld commands, %lld policy steps; latency state received -> command published: p50 %lld us, "
-                 "p99 %lld us over %lld commands\n",
+                 "p99 %lld us over %lld commands (until poll p50 %lld / p99 %lld us, poll %lld / %lld us, publish "
+                 "%lld / %lld us)\n",
                  deploy::modeName(runner.mode()), runner.reason().c_str(), static_cast<long long>(runner.statesReceived()),
                  static_cast<long long>(runner.statesIgnored()), static_cast<long long>(rejected_states),
                  static_cast<long long>(published), static_cast<long long>(runner.policySteps()),
-                 static_cast<long long>(latency.quantile(0.5)), static_cast<long long>(latency.quantile(0.99)),
-                 static_cast<long long>(latency.count()));
+                 static_cast<long long>(latency.total.quantile(0.5)), static_cast<long long>(latency.total.quantile(0.99)),
+                 static_cast<long long>(latency.total.count()), static_cast<long long>(latency.to_poll.quantile(0.5)),
+                 static_cast<long long>(latency.to_poll.quantile(0.99)), static_cast<long long>(latency.in_poll.quantile(0.5)),
+                 static_cast<long long>(latency.in_poll.quantile(0.99)), static_cast<long long>(latency.in_publish.quantile(0.5)),
+                 static_cast<long long>(latency.in_publish.quantile(0.99)));
     return exit_code;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_deploy: %s\n", e.what());

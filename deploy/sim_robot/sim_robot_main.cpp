@@ -7,7 +7,9 @@
 // At the end it prints the task's progress figures over the policy phase (commands in mode 1)
 // and whether the task's termination test fired (a fall). Fault injection for tests:
 // --stop-state-after S stops publishing state, --nan-state-after S publishes NaN joint angles;
-// both report when the first safe command (mode >= 2) arrived after the fault.
+// both report when the first safe command (mode >= 2) arrived after the fault; --tilt-state-after S
+// reports the base rolled by --tilt-rad more than it is (an IMU's view of a fall), and the robot
+// then reports its final joint angles and the fastest target change between emergency-stop commands.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -49,6 +51,7 @@ int main(int argc, char** argv) {
                                 command_channel = transport::kRobotCommandChannel;
   uint64_t seed = 0, fault_seed = 1;
   double duration = 10, delay_ms = 0, jitter_ms = 0, loss = 0, stop_state_after = -1, nan_state_after = -1;
+  double tilt_state_after = -1, tilt_rad = 1.0;
   int state_every = 1;
   bool quiet = false;
   app.add_option("policy", policy_path, "policy file: its task is built exactly as trained")->required()->check(CLI::ExistingFile);
@@ -61,6 +64,8 @@ int main(int argc, char** argv) {
   app.add_option("--fault-seed", fault_seed, "seed of the delay, jitter and loss generator")->capture_default_str();
   app.add_option("--stop-state-after", stop_state_after, "stop publishing state this many seconds after the first command");
   app.add_option("--nan-state-after", nan_state_after, "publish NaN joint angles from this many seconds after the first command");
+  app.add_option("--tilt-state-after", tilt_state_after, "report the base rolled by --tilt-rad from this many seconds after the first command");
+  app.add_option("--tilt-rad", tilt_rad, "extra roll reported by --tilt-state-after (rad)")->capture_default_str();
   app.add_option("--url", url, "LCM provider URL (default: LCM_DEFAULT_URL)");
   app.add_option("--state-channel", state_channel)->capture_default_str();
   app.add_option("--command-channel", command_channel)->capture_default_str();
@@ -102,10 +107,18 @@ int main(int argc, char** argv) {
     std::deque<Pending> pending;
     int64_t received = 0, lost_commands = 0, lost_states = 0;
     std::vector<int64_t> runners;  // ids of the runners heard
-    masa::lcmt_robot_command incoming{};
+    masa::lcmt_robot_command incoming{}, last_estop{};
+    double estop_max_rate = 0;  // rad/s: the fastest target change between two emergency-stop commands
     lcm.subscribeRaw(command_channel, [&](const void* data, int size) {
       if (transport::decodeChecked(data, size, incoming) != transport::WireVerdict::kOk || incoming.num_joints != n) return;
       ++received;
+      if (incoming.mode == 4) {
+        if (last_estop.num_joints == n && incoming.utime > last_estop.utime)
+          for (int k = 0; k < n; ++k)
+            estop_max_rate = std::max(estop_max_rate, std::abs(incoming.position[k] - last_estop.position[k]) /
+                                                          ((incoming.utime - last_estop.utime) * 1e-6));
+        last_estop = incoming;
+      }
       if (std::find(runners.begin(), runners.end(), incoming.runner_id) == runners.end()) runners.push_back(incoming.runner_id);
       if (loss > 0 && unit(fault) < loss) {
         ++lost_commands;
@@ -135,6 +148,12 @@ int main(int argc, char** argv) {
         const double* v = d->qvel + base_v;
         st.base_x = q[0], st.base_y = q[1], st.base_z = q[2];
         st.base_qw = q[3], st.base_qx = q[4], st.base_qy = q[5], st.base_qz = q[6];
+        if (tilt_state_after >= 0 && sim_t >= tilt_state_after) {  // q * (rotation about the body x by tilt_rad)
+          const double tilt[4] = {std::cos(tilt_rad / 2), std::sin(tilt_rad / 2), 0, 0};
+          double out[4];
+          mju_mulQuat(out, q + 3, tilt);
+          st.base_qw = out[0], st.base_qx = out[1], st.base_qy = out[2], st.base_qz = out[3];
+        }
         st.base_vx = v[0], st.base_vy = v[1], st.base_vz = v[2];
         st.base_wx = v[3], st.base_wy = v[4], st.base_wz = v[5];
       }
@@ -204,7 +223,8 @@ int main(int argc, char** argv) {
       const double t = steps * dt;
       const bool stopped = stop_state_after >= 0 && t >= stop_state_after;
       const bool nan = nan_state_after >= 0 && t >= nan_state_after;
-      if ((stopped || nan) && fault_at < 0) fault_at = t;
+      const bool tilted = tilt_state_after >= 0 && t >= tilt_state_after;
+      if ((stopped || nan || tilted) && fault_at < 0) fault_at = t;
       if (!stopped && steps % state_every == 0) {
         mj_kinematics(m, d);
         publishState(t);
@@ -231,6 +251,11 @@ int main(int argc, char** argv) {
                     prog_end[i] - prog_start[i]);
       std::printf("; fell: %s\n", fell_at >= 0 ? "yes" : "no");
       if (fell_at >= 0) std::printf("masa_sim_robot: fell at %.2f s\n", fell_at);
+    }
+    if (tilt_state_after >= 0) {
+      std::printf("masa_sim_robot: final joint angles:");
+      for (int k = 0; k < n; ++k) std::printf(" %.3f", d->qpos[qadr[k]]);
+      std::printf("\nmasa_sim_robot: fastest target change between emergency-stop commands: %.3f rad/s\n", estop_max_rate);
     }
     if (fault_at >= 0)
       std::printf("masa_sim_robot: fault at %.3f s; first safe command (mode %d) %s\n", fault_at, first_safe_mode,

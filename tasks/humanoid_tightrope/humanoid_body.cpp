@@ -32,6 +32,11 @@ HumanoidTask::HumanoidTask(std::string name, std::shared_ptr<const MujocoModel> 
   reset_noise_ = params.number("reset_noise", 0.01);
   start_hip_x_ = params.number("start_hip_x", start_hip_x_default);
   MASA_CHECK(reset_noise_ >= 0.0, "env.reset_noise must not be negative");
+  for (int k = 0; k < actDim(); ++k) {
+    const int q = m->jnt_qposadr[jointOfAction(k)];
+    const bool hip_x = std::find(hip_x_qpos_.begin(), hip_x_qpos_.end(), q) != hip_x_qpos_.end();
+    start_pose_.push_back(hip_x ? start_hip_x_ : m->qpos0[q]);
+  }
 }
 
 void HumanoidTask::randomizePose(Rng& rng) {

@@ -28,6 +28,12 @@ class HumanoidTask : public Task {
  public:
   static constexpr int kTorsoObs = 11;  // y, z, linear velocity (3), angular velocity (3), roll, pitch, yaw
 
+  // Motor torques (the humanoid is torque-controlled), with the start pose as position targets.
+  bool jointCommand(const double* action, double* position, double* velocity, double* torque_ff, double* kp,
+                    double* kd) const override {
+    return motorJointCommand(action, start_pose_.data(), position, velocity, torque_ff, kp, kd);
+  }
+
  protected:
   // start_hip_x: both hips' adduction angle (rad) of the start pose (invariant joints: the pose
   // stays mirror-symmetric). extra_central_obs: the task's own central entries after the 20
@@ -64,6 +70,7 @@ class HumanoidTask : public Task {
   std::vector<int> foot_geoms_;
   std::vector<int> hip_x_qpos_;
   double reset_noise_, start_hip_x_;
+  std::vector<double> start_pose_;  // the start pose without noise, action order
 };
 
 }  // namespace masa::task

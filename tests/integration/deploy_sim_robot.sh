@@ -3,11 +3,19 @@
 # would meet a robot. Usage: deploy_sim_robot.sh CASE PORT, CASE one of
 #   walk          the shipped A1 Beam policy walks the simulated robot at least as far as
 #                 masa_eval's episode of the same seed over as many control periods, without falling
+#   walk_tuned    walk with the latency settings of docs/benchmarks.md (busy poll, warm-up): the
+#                 same distance, no watchdog trip
 #   stale         the robot stops publishing state: the safe command within the watchdog's bound
 #   nan           the robot publishes NaN joint angles: the safe command within one period
 #   second_runner a second runner is refused by the start guard; the first goes on
 #   faults        commands delayed 4-8 ms and 5% of states and commands lost: the A1 still walks at
 #                 least 0.8 of masa_eval's distance in the same number of policy steps, without falling
+#   humanoid      the shipped Humanoid Tightrope policy (torque commands) lunges along the simulated
+#                 rope at least 0.8 of masa_eval's distance over as many control periods, no fall
+#   crouch        the A1 reports a 1 rad roll (a fall, to its IMU): the emergency stop folds it
+#                 into configs/deploy/a1_beam_sim.yaml's crouch pose, targets no faster than its rate
+#   refusals      the shipped TriFinger Lift, Ant Acrobatic and Humanoid Dribbling policies are
+#                 refused with their configs, naming the object the robot cannot measure
 # Prints "PASS: ..." or "FAIL: ...".
 set -uo pipefail
 case_name=$1
@@ -39,13 +47,16 @@ for b in "$deploy" "$sim" "$eval_bin"; do [ -x "$b" ] || fail "$b is missing: bu
 le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a <= b) }'; }
 
 case "$case_name" in
-walk)
+walk|walk_tuned)
   steps=250
+  sets=()
+  [ "$case_name" = walk_tuned ] && sets=(--set realtime.busy_poll_us=300 --set realtime.warm_up_us=1000)
   "$sim" "$policy" --seed 0 --duration 6.5 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" "${sets[@]}" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
   rc=$?
   wait "${pids[0]}"
   [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
+  trip=$(grep -m1 -E ": (watchdog|emergency stop):" "$work/deploy.log") && fail "the runner tripped: $trip"
   "$eval_bin" "$policy" --episodes 1 --seed 0 --max-steps $steps > "$work/eval.log" 2>&1 || fail "masa_eval failed"
   line=$(grep "policy phase" "$work/sim.log") || fail "the simulated robot saw no policy phase"
   walked=$(sed -E 's/.*distance_m [-0-9.]+ -> [-0-9.]+ \(change ([-0-9.]+)\).*/\1/' <<< "$line")
@@ -120,5 +131,62 @@ second_runner)
   grep -q "fell: no" "$work/sim.log" || fail "the robot fell while the second runner was refused"
   echo "PASS: the second runner was refused; the robot heard one runner"
   ;;
-*) echo "usage: $0 walk|faults|stale|nan|second_runner PORT"; exit 2 ;;
+humanoid)
+  policy="$src/tasks/humanoid_tightrope/policy/policy.bin"
+  config="$src/configs/deploy/humanoid_tightrope_sim.yaml"
+  steps=60  # 0.9 s of the 1.8 s lunge: the policy falls after it, in evaluation too
+  "$sim" "$policy" --seed 0 --duration 2 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
+  rc=$?
+  wait "${pids[0]}"
+  [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
+  trip=$(grep -m1 -E ": (watchdog|emergency stop):" "$work/deploy.log") && fail "the runner tripped: $trip"
+  "$eval_bin" "$policy" --episodes 1 --seed 0 --max-steps $steps > "$work/eval.log" 2>&1 || fail "masa_eval failed"
+  line=$(grep "policy phase" "$work/sim.log") || fail "the simulated robot saw no policy phase"
+  walked=$(sed -E 's/.*distance_m [-0-9.]+ -> [-0-9.]+ \(change ([-0-9.]+)\).*/\1/' <<< "$line")
+  periods=$(sed -E 's/.*\(([0-9]+) control periods.*/\1/' <<< "$line")
+  evaluated=$(awk -F'|' '$2 ~ /distance_m/ { gsub(/ /, "", $3); print $3 }' "$work/eval.log")
+  [ -n "$evaluated" ] || fail "no distance_m in masa_eval's output"
+  echo "simulated humanoid over LCM: $walked m in $periods control periods; masa_eval (seed 0, $steps steps): $evaluated m"
+  grep -q "fell: no" <<< "$line" || fail "the humanoid fell: $line"
+  [ "$periods" -ge $((steps - 1)) ] || fail "only $periods control periods under the policy, expected $steps"
+  # A lunge is a fall held off by the policy: a few ms of timing shift the chaos, not the distance.
+  le "$(awk -v e="$evaluated" 'BEGIN { print 0.8 * e }')" "$walked" || fail "lunged $walked m < 0.8 x $evaluated m"
+  echo "PASS: the humanoid lunged $walked m along the rope over LCM (masa_eval: $evaluated m)"
+  ;;
+crouch)
+  "$sim" "$policy" --seed 0 --duration 4 --quiet --tilt-state-after 1.0 --tilt-rad 1.0 > "$work/sim.log" 2>&1 & pids+=($!)
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 3.8 --quiet > "$work/deploy.log" 2>&1
+  rc=$?
+  wait "${pids[0]}"
+  [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
+  grep -q "emergency stop: roll" "$work/deploy.log" || fail "masa_deploy did not stop on the roll"
+  grep -q "first safe command (mode 4)" "$work/sim.log" || fail "the robot got no emergency-stop command"
+  rate=$(sed -nE 's/.*emergency-stop commands: ([0-9.]+) rad\/s.*/\1/p' "$work/sim.log")
+  max_rate=$(awk '/crouch_max_rate:/ { print $2 }' "$config")
+  [ -n "$rate" ] && [ -n "$max_rate" ] || fail "no crouch rate reported"
+  # utime has microsecond resolution: 1e-3 relative slack.
+  le "$rate" "$(awk -v r="$max_rate" 'BEGIN { print r * 1.001 }')" || fail "crouch targets moved at $rate rad/s > $max_rate"
+  final=$(sed -nE 's/.*final joint angles: (.*)/\1/p' "$work/sim.log")
+  pose=$(sed -nE 's/.*crouch_pose: \[(.*)\].*/\1/p' "$config" | tr -d ',')
+  worst=$(awk -v a="$final" -v b="$pose" 'BEGIN { n = split(a, x, " "); split(b, y, " "); w = 0;
+    for (i = 1; i <= n; ++i) { d = x[i] - y[i]; if (d < 0) d = -d; if (d > w) w = d } print w }')
+  echo "final joint angles: $final; crouch pose: $pose; worst error $worst rad; fastest target change $rate rad/s"
+  # The PD loop (kp 40) under the trunk's weight on the ground leaves some error; 0.15 rad is a crouch.
+  le "$worst" 0.15 || fail "the A1 did not reach its crouch pose: worst joint $worst rad off"
+  echo "PASS: the emergency stop crouched the A1 (worst joint $worst rad off the pose, targets at most $rate rad/s, limit $max_rate)"
+  ;;
+refusals)
+  for entry in trifinger_lift:cube ant_acrobatic:ball_root humanoid_dribbling:ball; do
+    task=${entry%%:*} joint=${entry#*:}
+    "$deploy" "$src/tasks/$task/policy/policy.bin" --config "$src/configs/deploy/$task.yaml" --quiet > "$work/$task.log" 2>&1
+    rc=$?
+    [ $rc -eq 2 ] || fail "$task: masa_deploy exited with $rc, expected 2 (refused)"
+    grep -q "task $task cannot run on a robot's state alone: joint '$joint' is neither driven" "$work/$task.log" ||
+      fail "$task: refused without naming joint '$joint': $(cat "$work/$task.log")"
+    echo "$task: $(grep -o "cannot run.*" "$work/$task.log")"
+  done
+  echo "PASS: TriFinger Lift, Ant Acrobatic and Humanoid Dribbling are refused, naming what the robot cannot measure"
+  ;;
+*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals PORT"; exit 2 ;;
 esac

@@ -19,6 +19,7 @@
 #include "common/policy/policy_file.hpp"
 #include "deploy/runner/deploy_config.hpp"
 #include "deploy/runner/policy_runner.hpp"
+#include "deploy/runner/realtime.hpp"
 
 namespace masa::deploy {
 namespace {
@@ -102,6 +103,45 @@ TEST(DeployRunner, ObservationFromAStateMessageEqualsTheTasksOwnInSimulation) {
   }
 }
 
+// The humanoid is torque-controlled: its joint command is the motor torque the task applies for
+// the same action (gains zero), and its observation from a state message is the task's own.
+TEST(DeployRunner, HumanoidJointCommandIsTheTasksMotorTorqueAndItsObservationTheTasksOwn) {
+  policy::LoadedPolicy lp =
+      policy::loadPolicyFile(std::string(MASA_SOURCE_DIR) + "/tasks/humanoid_tightrope/policy/policy.bin");
+  task::TaskFactory factory{lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source};
+  std::unique_ptr<task::Task> sim = factory.create(), robot_side = factory.create();
+  Rng rng(5);
+  sim->reset(rng);
+  const int n = sim->actDim();
+  const mjModel* m = sim->model();
+  std::normal_distribution<float> noise(0.0f, 0.7f);
+  std::vector<float> a(n), want(sim->obsDim()), got(sim->obsDim());
+  std::vector<double> action(n), pos(n), vel(n), tau(n), kp(n), kd(n), q(n), qd(n);
+  for (int t = 0; t < 10; ++t) {
+    for (int k = 0; k < n; ++k) action[k] = a[k] = noise(rng);
+    ASSERT_TRUE(sim->jointCommand(action.data(), pos.data(), vel.data(), tau.data(), kp.data(), kd.data()));
+    sim->actuate(a.data());
+    for (int k = 0; k < n; ++k) {
+      const int act = sim->actuatorOfAction(k);
+      EXPECT_NEAR(tau[k], sim->data()->ctrl[act] * m->actuator_gear[6 * act], 1e-12) << "action " << k;
+      EXPECT_EQ(kp[k], 0.0);
+      EXPECT_EQ(kd[k], 0.0);
+    }
+    sim->step(a.data());
+    sim->observe(want.data());
+    const int root = mj_name2id(m, mjOBJ_JOINT, "root");
+    for (int k = 0; k < n; ++k) {
+      const int j = sim->jointOfAction(k);
+      q[k] = sim->data()->qpos[m->jnt_qposadr[j]];
+      qd[k] = sim->data()->qvel[m->jnt_dofadr[j]];
+    }
+    robot_side->setMeasuredState(q.data(), qd.data(), sim->data()->qpos + m->jnt_qposadr[root],
+                                 sim->data()->qvel + m->jnt_dofadr[root], sim->lastAction().data());
+    robot_side->observe(got.data());
+    for (int i = 0; i < sim->obsDim(); ++i) ASSERT_EQ(got[i], want[i]) << "observation entry " << i << " at step " << t;
+  }
+}
+
 TEST(DeployRunner, StaleStateGivesTheSafeCommandWithinTheBoundAndSaysWhy) {
   Fixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
@@ -176,6 +216,88 @@ TEST(DeployRunner, EmergencyStopOnTheOrientationLimit) {
   ASSERT_TRUE(r.poll(1500000, cmd));
   EXPECT_EQ(cmd.mode, static_cast<int>(Mode::kEmergencyStop));
   EXPECT_NE(r.reason().find("roll"), std::string::npos) << r.reason();
+}
+
+// The A1's crouch (walk-these-ways' fall response): on the orientation limit the targets leave the
+// measured pose for the crouch pose at no more than crouch_max_rate, reach it, and stay there with
+// the crouch gains, latched, even when the state then stops.
+TEST(DeployRunner, EmergencyCrouchReachesTheCrouchPoseWithinItsRate) {
+  Fixture f;
+  DeployConfig c = testConfig();
+  c.emergency_response = EmergencyResponse::kCrouch;
+  c.crouch_pose.clear();
+  for (int leg = 0; leg < 4; ++leg) c.crouch_pose.insert(c.crouch_pose.end(), {0.0, 1.2, -2.4});
+  c.crouch_max_rate = 1.0;
+  c.crouch_kp = 30.0;
+  c.crouch_kd = 1.5;
+  PolicyRunner r(f.lp, c, 1);
+  int64_t utime = 0;
+  drive(r, *f.sim, 0, 1500000, 5000, utime);
+  ASSERT_EQ(r.mode(), Mode::kPolicy);
+  masa::lcmt_robot_state s = stateOf(*f.sim, ++utime);
+  const double roll = 1.0;
+  s.base_qw = std::cos(roll / 2), s.base_qx = std::sin(roll / 2), s.base_qy = s.base_qz = 0;
+  // The robot has been thrown about: its joints are away from the last target.
+  for (int k = 0; k < r.numJoints(); ++k) s.joint_position[k] += k % 2 ? 0.3 : -0.3;
+  const std::vector<double> measured(s.joint_position.begin(), s.joint_position.end());
+  r.onState(s, 1500000);
+  masa::lcmt_robot_command cmd = r.makeCommand();
+  ASSERT_TRUE(r.poll(1500000, cmd));
+  ASSERT_EQ(cmd.mode, static_cast<int>(Mode::kEmergencyStop));
+  EXPECT_TRUE(r.crouching());
+  std::vector<double> prev = measured;
+  int64_t last_t = 1500000 - static_cast<int64_t>(r.periodS() * 1e6);
+  double farthest = 0;  // rad between the measured pose and the crouch pose
+  for (int k = 0; k < r.numJoints(); ++k) farthest = std::max(farthest, std::abs(c.crouch_pose[k] - measured[k]));
+  int64_t reached_at = -1;
+  for (int64_t t = 1500000, n = 0; t < 6000000; t += 500) {
+    if (t > 1500000 && t < 2000000 && t % 5000 == 0) r.onState(stateOf(*f.sim, ++utime), t);  // then the state stops
+    if (t > 1500000 && !r.poll(t, cmd)) continue;
+    ++n;
+    ASSERT_EQ(cmd.mode, static_cast<int>(Mode::kEmergencyStop)) << "at " << t;
+    bool at_pose = true;
+    for (int k = 0; k < r.numJoints(); ++k) {
+      ASSERT_LE(std::abs(cmd.position[k] - prev[k]), c.crouch_max_rate * (t - last_t) * 1e-6 + 1e-12)
+          << "joint " << k << " moved too fast at " << t;
+      ASSERT_EQ(cmd.kp[k], c.crouch_kp);
+      ASSERT_EQ(cmd.kd[k], c.crouch_kd);
+      at_pose = at_pose && cmd.position[k] == c.crouch_pose[k];
+    }
+    if (at_pose && reached_at < 0) reached_at = t;
+    prev.assign(cmd.position.begin(), cmd.position.end());
+    last_t = t;
+  }
+  ASSERT_GT(reached_at, 0) << "the crouch pose was never reached";
+  // No faster than the rate allows, and not much slower: one period of slack.
+  const double took_s = (reached_at - 1500000) * 1e-6 + r.periodS();
+  EXPECT_GE(took_s + 1e-9, farthest / c.crouch_max_rate);
+  EXPECT_LE(took_s, farthest / c.crouch_max_rate + 2 * r.periodS());
+  EXPECT_NE(r.reason().find("emergency stop"), std::string::npos) << r.reason();
+}
+
+TEST(DeployRunner, CrouchPoseOfTheWrongSizeOrOutsideTheLimitsIsRefused) {
+  Fixture f;
+  DeployConfig c = testConfig();
+  c.emergency_response = EmergencyResponse::kCrouch;
+  c.crouch_pose = {0.0, 1.2, -2.4};
+  try {
+    PolicyRunner r(f.lp, c, 1);
+    FAIL() << "a 3-value crouch pose was accepted for 12 joints";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("has 3 values"), std::string::npos) << e.what();
+  }
+  c.crouch_pose.clear();
+  for (int leg = 0; leg < 4; ++leg) c.crouch_pose.insert(c.crouch_pose.end(), {0.0, 1.2, -2.69});  // calf limit -2.697 less 0.05
+  try {
+    PolicyRunner r(f.lp, c, 1);
+    FAIL() << "a crouch pose beyond the position margin was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("FR_calf_joint"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(loadDeployConfig("", {"emergency.response=crouch"}), ConfigError);  // no pose
+  const std::string pose = "emergency.crouch_pose=[0, 1.2, -2.4, 0, 1.2, -2.4, 0, 1.2, -2.4, 0, 1.2, -2.4]";
+  EXPECT_THROW(loadDeployConfig("", {"emergency.response=crouch", pose, "emergency.crouch_kp=500"}), ConfigError);  // above limits.max_kp
+  EXPECT_NO_THROW(loadDeployConfig("", {"emergency.response=crouch", pose}));
 }
 
 // Every command of a runner with random networks, on random states, keeps the limits.
@@ -282,10 +404,50 @@ TEST(DeployRunner, ControlStepAllocatesNothing) {
       ++s.utime;
       r.onState(s, t);
     }
+    if (t % 2500 == 0) r.warmUp();
     r.poll(t, cmd);
   }
   EXPECT_EQ(test::allocationCount() - before, 0);
   EXPECT_GE(r.policySteps() - steps_before, 45);
+}
+
+// The cache warm-up before a command (realtime.warm_up_us) changes no command.
+TEST(DeployRunner, WarmUpChangesNoCommand) {
+  Fixture f, g;
+  PolicyRunner plain(f.lp, testConfig(), 1), warmed(g.lp, testConfig(), 1);
+  masa::lcmt_robot_command a = plain.makeCommand(), b = warmed.makeCommand();
+  Rng rng(4);
+  std::normal_distribution<double> noise(0.0, 0.2);
+  int compared = 0;
+  for (int64_t t = 0, utime = 0; t < 3000000; t += 500) {
+    if (t % 2000 == 0) {
+      masa::lcmt_robot_state s = stateOf(*f.sim, ++utime);
+      for (double& q : s.joint_position) q += noise(rng);
+      plain.onState(s, t);
+      warmed.onState(s, t);
+    }
+    if (t % 1500 == 0) warmed.warmUp();
+    const bool pa = plain.poll(t, a), pb = warmed.poll(t, b);
+    ASSERT_EQ(pa, pb) << "at " << t;
+    if (!pa) continue;
+    for (int k = 0; k < plain.numJoints(); ++k) ASSERT_EQ(a.position[k], b.position[k]) << "joint " << k << " at " << t;
+    compared += a.mode == static_cast<int>(Mode::kPolicy);
+  }
+  EXPECT_GT(compared, 60);
+}
+
+// realtime: settings the system refuses are said, not fatal; bad values are config errors.
+TEST(DeployRealtime, RefusedSettingsAreSaidAndBadValuesAreErrors) {
+  EXPECT_EQ(applyRealtime(RealtimeSettings{}), "normal scheduling");
+  RealtimeSettings no_such_core;
+  no_such_core.cpu = 4000;  // sched_setaffinity fails; this process keeps its cores
+  EXPECT_NE(applyRealtime(no_such_core).find("NOT pinned to core 4000"), std::string::npos);
+  EXPECT_THROW(loadDeployConfig("", {"realtime.priority=100"}), ConfigError);
+  EXPECT_THROW(loadDeployConfig("", {"realtime.cpu=1.5"}), ConfigError);
+  EXPECT_THROW(loadDeployConfig("", {"realtime.busy_poll_us=-1"}), ConfigError);
+  const DeployConfig c = loadDeployConfig("", {"realtime.priority=50", "realtime.warm_up_us=1000"});
+  EXPECT_EQ(c.realtime.priority, 50);
+  EXPECT_EQ(c.warm_up_us, 1000);
 }
 
 TEST(DeployConfig, UnknownKeyAndBadValueNameTheKey) {
