@@ -144,11 +144,12 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
     // the learner drops every chunk acted with it (future_version). Taking the learner's version
     // back ends that; a replay that pushes us back costs stale chunks until the next update.
     if (++behind_in_a_row_ < options_.behind_repeats_to_take_back) return;
-    std::fprintf(stderr,
-                 "masa_actor %d: taking parameters version %lld back from %lld: %d valid messages in a row below "
-                 "this actor's version, none at it (was %lld forged or corrupted? use the run key)\n",
-                 options_.actor_id, static_cast<long long>(m.version), static_cast<long long>(newest),
-                 behind_in_a_row_, static_cast<long long>(newest));
+    if (pending_version_ != m.version)  // once: the repeats until the next rollout take it again
+      std::fprintf(stderr,
+                   "masa_actor %d: taking parameters version %lld back from %lld: %d valid messages in a row below "
+                   "this actor's version, none at it (was %lld forged or corrupted? use the run key)\n",
+                   options_.actor_id, static_cast<long long>(m.version), static_cast<long long>(newest),
+                   behind_in_a_row_, static_cast<long long>(newest));
   }
   behind_in_a_row_ = 0;
   std::copy(m.params.begin(), m.params.end(), pending_params_.begin());
