@@ -54,14 +54,17 @@ struct ActorOptions {
   // away instead of published, chosen by a generator seeded with drop_seed (reproducible).
   double drop_chunks_percent = 0.0;
   uint64_t drop_seed = 1;
-  // After each rollout, wait up to this long for parameters newer than the ones it acted with.
-  // Without the wait a fast actor collects rollouts the learner will drop as stale (with
-  // max_policy_lag 0, a third of the data in a 2-actor run). Bounded, so that a batch still fills
-  // when another actor is dead (at the cost of this wait per update). 0: never wait.
+  // After each rollout, wait for parameters newer than the ones it acted with. Without the wait a
+  // fast actor collects rollouts the learner will drop as stale (with max_policy_lag 0, a third of
+  // the data in a 2-actor run). Bounded, so that a batch still fills when another actor is dead or
+  // a chunk was lost (at the cost of this wait). This long until the learner has answered once;
+  // 0: never wait.
   double await_params_s = 1.0;
-  // The wait grows to 1.5x the learner's recent answer time (from the end of a rollout to the
-  // next parameters), up to this bound: a big batch's update outlasts await_params_s.
+  // Then 1.5x the learner's recent answer time (from the end of a rollout to the next parameters),
+  // between these bounds (AwaitBudget): a big batch's update outlasts await_params_s, and a fast
+  // learner short of a lost chunk's environments should not stand still for it.
   double await_params_max_s = 10.0;
+  double await_params_min_s = 0.02;
   // An actor whose learner is gone (no parameters, not even the learner's periodic repeat) stops
   // publishing after this long, says so, and exits after learner_silence_exit_s. 0: never.
   double learner_silence_pause_s = 30.0;
@@ -159,7 +162,7 @@ class Actor {
   double rollout_end_s_ = 0;    // when the last rollout was published (0: answered already)
   double last_learner_s_ = 0;   // when the learner was last heard (new parameters or its repeat)
   // The wait for newer parameters, adapted to the learner's answer time (options_ is declared above).
-  AwaitBudget await_budget_{options_.await_params_s, options_.await_params_max_s};
+  AwaitBudget await_budget_{options_.await_params_s, options_.await_params_max_s, options_.await_params_min_s};
   // Nothing of a rejected message is kept but these counts: it cannot change what comes after it.
   int64_t params_rejected_ = 0;
   int64_t rejects_since_warning_ = 0;

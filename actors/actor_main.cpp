@@ -41,10 +41,13 @@ int main(int argc, char** argv) {
   app.add_option("--threads", opt.threads, "OpenMP threads over environments")->capture_default_str()
       ->check(CLI::Range(1, 1 << 20));
   app.add_option("--await-params-s", opt.await_params_s,
-                 "after each rollout, wait up to this long for newer parameters (0: never; keeps data on-policy)")
+                 "after each rollout, wait up to this long for newer parameters until the learner has answered "
+                 "once (0: never wait; keeps data on-policy)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--await-params-max-s", opt.await_params_max_s,
-                 "the wait adapts to the learner's answer time (1.5x), up to this long")
+                 "then the wait is 1.5x the learner's answer time, up to this long")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--await-params-min-s", opt.await_params_min_s, "... and at least this long")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--learner-silence-pause-s", opt.learner_silence_pause_s,
                  "stop publishing after hearing nothing from the learner this long (0: never)")

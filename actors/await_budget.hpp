@@ -1,8 +1,12 @@
 // How long an actor waits, after publishing a rollout, for parameters newer than those it acted
-// with: at least the configured wait, and 1.5x the learner's recent answer time (a moving average
-// of the time from a rollout's end to the next parameters) up to a bound. A learner whose updates
-// outlast the configured wait (a big batch, a loaded machine) would otherwise receive rollouts of
-// an old policy that it must drop. Pure arithmetic: tested without a clock.
+// with: the configured wait until the learner has answered once, then 1.5x the learner's recent
+// answer time (a moving average of the time from a rollout's end to the next parameters), between
+// a floor and a bound. Longer than the configured wait: a learner whose updates outlast it (a big
+// batch, a loaded machine) would otherwise receive rollouts of an old policy that it must drop.
+// Shorter: when a chunk is lost the learner cannot complete its batch and says nothing, and every
+// actor waited the whole configured second before sending the environments that replace it (at 5%
+// loss, 0.15 of the lossless update rate on the namespace LAN; bench/e2e_loss.sh).
+// Pure arithmetic: tested without a clock.
 #pragma once
 
 #include <algorithm>
@@ -12,7 +16,7 @@ namespace masa::actor {
 class AwaitBudget {
  public:
   // base_s <= 0: never wait.
-  AwaitBudget(double base_s, double max_s) : base_s_(base_s), max_s_(max_s) {}
+  AwaitBudget(double base_s, double max_s, double min_s = 0.02) : base_s_(base_s), max_s_(max_s), min_s_(min_s) {}
 
   // The learner answered a rollout after `delay_s` seconds.
   void observeAnswer(double delay_s) {
@@ -22,11 +26,12 @@ class AwaitBudget {
 
   double limitSeconds() const {
     if (base_s_ <= 0) return 0.0;
-    return std::max(base_s_, std::min(max_s_, 1.5 * learner_delay_s_));
+    if (learner_delay_s_ <= 0) return base_s_;  // not measured yet
+    return std::clamp(1.5 * learner_delay_s_, std::min(min_s_, max_s_), max_s_);
   }
 
  private:
-  double base_s_, max_s_;
+  double base_s_, max_s_, min_s_;
   double learner_delay_s_ = 0;
 };
 

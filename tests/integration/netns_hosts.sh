@@ -10,28 +10,33 @@
 #      pipe closes: see deploy/tethered.sh).
 # With --drop P, instead: nftables on the learner's host drops P% of the inbound rollout datagrams
 # at random; training must not stall (12 updates), and the learner must count the lost chunks.
-#   MASA_BUILD_DIR=build bash tests/integration/netns_hosts.sh [--port PORT] [--drop PERCENT]
+# With --measure N (bench/e2e_loss.sh), instead: N updates with --drop P% loss (0 allowed), and a
+# last line "MEASURE: drop P% ... updates_per_minute X" over the updates after the first 5.
+#   MASA_BUILD_DIR=build bash tests/integration/netns_hosts.sh [--port PORT] [--drop PERCENT] [--measure N]
 # Needs root and `ip netns` (and nft for --drop); otherwise it prints SKIP and exits 77.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 source tests/integration/lib.sh
 
-port=7673 drop=0
+port=7673 drop=0 measure=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --port) port=$2; shift 2 ;;
     --drop) drop=$2; shift 2 ;;
+    --measure) measure=$2; shift 2 ;;
     *) echo "netns_hosts.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 
 [[ "$drop" =~ ^[0-9]+$ ]] && [ "$drop" -le 99 ] || { echo "netns_hosts.sh: --drop takes 0 to 99 (percent)" >&2; exit 2; }
+[[ "$measure" =~ ^[0-9]+$ ]] && { [ "$measure" = 0 ] || [ "$measure" -ge 10 ]; } ||
+  { echo "netns_hosts.sh: --measure takes a number of updates, at least 10" >&2; exit 2; }
 
 skip() { echo "SKIP: $*"; exit 77; }
 [ "$(id -u)" = 0 ] || skip "making network namespaces needs root"
 command -v ip >/dev/null || skip "iproute2 ('ip') is not installed"
 ip netns list >/dev/null 2>&1 || skip "'ip netns' is not available"
-if [ "$drop" -gt 0 ]; then command -v nft >/dev/null || skip "nftables ('nft') is not installed"; fi
+if [ "$drop" -gt 0 ] || [ "$measure" -gt 0 ]; then command -v nft >/dev/null || skip "nftables ('nft') is not installed"; fi
 require_binaries
 
 # Names unique to this run, so that parallel runs do not collide.
@@ -80,7 +85,7 @@ launcher=(ip netns exec "$ns_l" env MASA_BUILD_DIR="$build" MASA_LCM_URL="$url"
 no_actor_left() { [ -z "$(ip netns pids "$ns_a")$(ip netns pids "$ns_b")" ]; }
 run_dir_of() { ls -d "$1"/*/ 2>/dev/null | head -1; }
 
-if [ "$drop" -gt 0 ]; then
+if [ "$drop" -gt 0 ] || [ "$measure" -gt 0 ]; then
   # Random loss of the rollout datagrams that reach the learner's host from the actor hosts (tc
   # netem is not in this kernel). Only datagrams over 1000 bytes are dropped: rollout chunks are
   # larger, heartbeats and hellos smaller. Dropping those too made the test flaky (CI: 7 datagrams
@@ -96,6 +101,18 @@ table inet masa_test {
 }
 EOF
   log "nftables on $ns_l drops $drop% of the UDP datagrams over 1000 bytes to port $port from the actor hosts"
+  if [ "$measure" -gt 0 ]; then
+    MASA_RUNS_DIR="$work/runs" timeout 600 "${launcher[@]}" --updates "$measure" > "$work/launcher.log" 2>&1 ||
+      fail "the launcher did not finish $measure updates with $drop% loss (status $?)"
+    csv="$(run_dir_of "$work/runs")metrics.csv"
+    # Steady state: from the end of update 5 to the last (wall_time_s is column 4).
+    upm=$(awk -F, -v n="$measure" 'NR == 6 { t0 = $4 } NR == n + 1 { t1 = $4 } END { printf "%.1f", (n - 5) * 60 / (t1 - t0) }' "$csv")
+    drops=$(grep "^masa_learner: rollout chunks accepted" "$work/launcher.log" | tail -1 | sed 's/^masa_learner: //')
+    dropped=$(ip netns exec "$ns_l" nft list chain inet masa_test input | sed -n 's/.*counter packets \([0-9]*\).*/\1/p')
+    echo "MEASURE: drop $drop% updates $measure datagrams_dropped ${dropped:-0} ($drops) updates_per_minute $upm"
+    rm -rf "$work"
+    exit 0
+  fi
   MASA_RUNS_DIR="$work/runs" timeout 90 "${launcher[@]}" --updates 12 > "$work/launcher.log" 2>&1 ||
     fail "the launcher did not finish 12 updates with $drop% loss (status $?)"
   grep -q "stopped after 12 updates; checkpoint written" "$work/launcher.log" || fail "the learner did not finish 12 updates"

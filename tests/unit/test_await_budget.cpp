@@ -5,16 +5,26 @@
 
 using masa::actor::AwaitBudget;
 
-TEST(AwaitBudget, WaitsTheConfiguredTimeUntilTheLearnerIsSlowerThenOneAndAHalfItsAnswerTime) {
+TEST(AwaitBudget, WaitsTheConfiguredTimeUntilMeasuredThenOneAndAHalfTheLearnersAnswerTime) {
   AwaitBudget b(1.0, 10.0);
-  EXPECT_DOUBLE_EQ(b.limitSeconds(), 1.0);  // nothing measured yet
-  b.observeAnswer(0.4);                     // a fast learner: the configured wait stands
-  EXPECT_DOUBLE_EQ(b.limitSeconds(), 1.0);
-  b.observeAnswer(4.0);                     // moving average 0.7 * 0.4 + 0.3 * 4 = 1.48
-  EXPECT_NEAR(b.learnerDelaySeconds(), 1.48, 1e-12);
-  EXPECT_NEAR(b.limitSeconds(), 2.22, 1e-12);
-  for (int i = 0; i < 40; ++i) b.observeAnswer(4.0);  // settles at 4 s: wait 6 s
-  EXPECT_NEAR(b.limitSeconds(), 6.0, 1e-5);
+  EXPECT_DOUBLE_EQ(b.limitSeconds(), 1.0);  // nothing measured yet: the configured wait
+  b.observeAnswer(4.0);                     // a slow learner: longer
+  EXPECT_NEAR(b.limitSeconds(), 6.0, 1e-12);
+  for (int i = 0; i < 40; ++i) b.observeAnswer(0.04);  // settles at 40 ms: wait 60 ms
+  EXPECT_NEAR(b.limitSeconds(), 0.06, 1e-5);
+}
+
+// A lost chunk leaves the learner's batch short, and it says nothing: the actors' wait is the
+// time the whole run stands still. It follows a fast learner down, to a floor.
+TEST(AwaitBudget, AFastLearnersWaitIsShortNotTheConfiguredSecond) {
+  AwaitBudget b(1.0, 10.0, 0.02);
+  b.observeAnswer(0.03);
+  EXPECT_NEAR(b.limitSeconds(), 0.045, 1e-12);
+  b.observeAnswer(0.001);  // average 0.0213: 1.5x is 0.032
+  EXPECT_NEAR(b.limitSeconds(), 1.5 * (0.7 * 0.03 + 0.3 * 0.001), 1e-12);
+  AwaitBudget floor(1.0, 10.0, 0.02);
+  floor.observeAnswer(0.001);
+  EXPECT_DOUBLE_EQ(floor.limitSeconds(), 0.02);
 }
 
 TEST(AwaitBudget, IsBoundedAndCanBeSwitchedOff) {
