@@ -46,26 +46,38 @@ for b in "$deploy" "$sim" "$eval_bin"; do [ -x "$b" ] || fail "$b is missing: bu
 # le A B: A <= B (floating point)
 le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a <= b) }'; }
 
-case "$case_name" in
-walk|walk_tuned)
-  steps=250
-  sets=()
-  [ "$case_name" = walk_tuned ] && sets=(--set realtime.busy_poll_us=300 --set realtime.warm_up_us=1000)
-  "$sim" "$policy" --seed 0 --duration 6.5 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" "${sets[@]}" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
-  rc=$?
+# drive ROBOT STEPS SIM_SECONDS [masa_deploy args...]: $policy with $config on the simulated robot for
+# STEPS policy steps, then masa_eval's episode of the same seed and length; sets walked (metres the
+# robot covered), periods (control periods under the policy) and evaluated (masa_eval's metres), and
+# fails on a runner trip, a fall or missing periods.
+drive() {
+  local robot=$1 steps=$2 seconds=$3
+  shift 3
+  "$sim" "$policy" --seed 0 --duration "$seconds" --quiet > "$work/sim.log" 2>&1 & pids+=($!)
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" "$@" --max-policy-steps "$steps" --quiet > "$work/deploy.log" 2>&1
+  local rc=$?
   wait "${pids[0]}"
   [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
+  local trip
   trip=$(grep -m1 -E ": (watchdog|emergency stop):" "$work/deploy.log") && fail "the runner tripped: $trip"
-  "$eval_bin" "$policy" --episodes 1 --seed 0 --max-steps $steps > "$work/eval.log" 2>&1 || fail "masa_eval failed"
+  "$eval_bin" "$policy" --episodes 1 --seed 0 --max-steps "$steps" > "$work/eval.log" 2>&1 || fail "masa_eval failed"
+  local line
   line=$(grep "policy phase" "$work/sim.log") || fail "the simulated robot saw no policy phase"
   walked=$(sed -E 's/.*distance_m [-0-9.]+ -> [-0-9.]+ \(change ([-0-9.]+)\).*/\1/' <<< "$line")
   periods=$(sed -E 's/.*\(([0-9]+) control periods.*/\1/' <<< "$line")
   evaluated=$(awk -F'|' '$2 ~ /distance_m/ { gsub(/ /, "", $3); print $3 }' "$work/eval.log")
   [ -n "$evaluated" ] || fail "no distance_m in masa_eval's output"
-  echo "simulated robot over LCM: $walked m in $periods control periods; masa_eval (seed 0, $steps steps): $evaluated m"
-  grep -q "fell: no" <<< "$line" || fail "the robot fell: $line"
+  echo "simulated $robot over LCM: $walked m in $periods control periods; masa_eval (seed 0, $steps steps): $evaluated m"
+  grep -q "fell: no" <<< "$line" || fail "the $robot fell: $line"
   [ "$periods" -ge $((steps - 1)) ] || fail "only $periods control periods under the policy, expected $steps"
+}
+
+case "$case_name" in
+walk|walk_tuned)
+  steps=250
+  sets=()
+  [ "$case_name" = walk_tuned ] && sets=(--set realtime.busy_poll_us=300 --set realtime.warm_up_us=1000)
+  drive robot $steps 6.5 "${sets[@]}"
   # One control period at the task's 0.5 m/s (0.01 m): an asynchronous loop's timing resolution.
   le "$(awk -v e="$evaluated" 'BEGIN { print e - 0.01 }')" "$walked" || fail "walked $walked m < $evaluated m - 0.01 m"
   echo "PASS: the A1 walked $walked m over LCM (masa_eval: $evaluated m)"
@@ -135,21 +147,7 @@ humanoid)
   policy="$src/tasks/humanoid_tightrope/policy/policy.bin"
   config="$src/configs/deploy/humanoid_tightrope_sim.yaml"
   steps=60  # 0.9 s of the 1.8 s lunge: the policy falls after it, in evaluation too
-  "$sim" "$policy" --seed 0 --duration 2 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
-  rc=$?
-  wait "${pids[0]}"
-  [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
-  trip=$(grep -m1 -E ": (watchdog|emergency stop):" "$work/deploy.log") && fail "the runner tripped: $trip"
-  "$eval_bin" "$policy" --episodes 1 --seed 0 --max-steps $steps > "$work/eval.log" 2>&1 || fail "masa_eval failed"
-  line=$(grep "policy phase" "$work/sim.log") || fail "the simulated robot saw no policy phase"
-  walked=$(sed -E 's/.*distance_m [-0-9.]+ -> [-0-9.]+ \(change ([-0-9.]+)\).*/\1/' <<< "$line")
-  periods=$(sed -E 's/.*\(([0-9]+) control periods.*/\1/' <<< "$line")
-  evaluated=$(awk -F'|' '$2 ~ /distance_m/ { gsub(/ /, "", $3); print $3 }' "$work/eval.log")
-  [ -n "$evaluated" ] || fail "no distance_m in masa_eval's output"
-  echo "simulated humanoid over LCM: $walked m in $periods control periods; masa_eval (seed 0, $steps steps): $evaluated m"
-  grep -q "fell: no" <<< "$line" || fail "the humanoid fell: $line"
-  [ "$periods" -ge $((steps - 1)) ] || fail "only $periods control periods under the policy, expected $steps"
+  drive humanoid $steps 2
   # A lunge is a fall held off by the policy: a few ms of timing shift the chaos, not the distance.
   le "$(awk -v e="$evaluated" 'BEGIN { print 0.8 * e }')" "$walked" || fail "lunged $walked m < 0.8 x $evaluated m"
   echo "PASS: the humanoid lunged $walked m along the rope over LCM (masa_eval: $evaluated m)"
