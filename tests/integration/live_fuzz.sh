@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # A hostile publisher on a live run (issue #9): a learner and two actors train over real multicast
 # (udpm, ttl=0) while masa_lcm_fuzz republishes mutated copies of their live messages on every
-# channel at 200 per second for 8 s.
+# channel at 200 per second for 5 s.
 #  1. Without authentication (--no-auth) the copies reach the wire guards and the validators: the
 #     run still makes its updates, no process dies, every process exits cleanly, the learner's
 #     parameters stay finite (its policy file loads, its MASA equivariance is checked on load, and
@@ -20,7 +20,7 @@ fuzz_bin="$build/tools/masa_lcm_fuzz"
 eval_bin="$build/tools/masa_eval"
 for b in "$fuzz_bin" "$eval_bin"; do [ -x "$b" ] || { echo "FAIL: $b is missing: build first"; exit 1; }; done
 
-# fuzzed_run NAME [auth args...]: learner + 2 actors, the fuzzer for 8 s from the first update.
+# fuzzed_run NAME [auth args...]: learner + 2 actors, the fuzzer for 5 s from the first update.
 fuzzed_run() {
   local name=$1
   shift
@@ -35,8 +35,8 @@ fuzzed_run() {
   wait_until 60 "$name: a first update" at_least_updates "$run" 1
   local at_start
   at_start=$(updates_in "$run")
-  # 8 s at 200 copies per second, and at least 8 updates made meanwhile.
-  "$fuzz_bin" --url "$url" --rate 200 --duration 8 --seed 7 > "$work/$name.fuzz.log" 2>&1 &
+  # 5 s at 200 copies per second, and at least 8 updates made meanwhile.
+  "$fuzz_bin" --url "$url" --rate 200 --duration 5 --seed 7 > "$work/$name.fuzz.log" 2>&1 &
   fuzz_pid=$!
   started_pids+=("$fuzz_pid")
   wait_until 120 "$name: 8 updates under fuzzing" at_least_updates "$run" $((at_start + 8))
