@@ -6,7 +6,7 @@
 #   bench/e2e_efficiency.sh [--recipe a1_beam] [--scale S] [--actors K] [--updates N] [--warmup W]
 # --scale S multiplies the recipe's environments (and minibatch) by S (the issue's "4x its
 # environments": --scale 4). MASA_BUILD_DIR (default build) chooses the binaries; the run uses its
-# own LCM port (7691) so it never mixes with a training run.
+# own LCM port (7695) so it never mixes with a training run or a test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 recipe=a1_beam scale=1 actors=2 updates=40 warmup=10
@@ -33,7 +33,7 @@ echo "$bound_out"
 bound=$(sed -n 's/^bound \([0-9.]*\) .*/\1/p' <<< "$bound_out")
 
 run_dir=$(mktemp -d /tmp/masa_e2e_eff.XXXXXX)
-MASA_LCM_URL="udpm://239.255.76.67:7691?ttl=0&recv_buf_size=$(cat /proc/sys/net/core/rmem_max)" \
+MASA_LCM_URL="udpm://239.255.76.67:7695?ttl=0&recv_buf_size=$(cat /proc/sys/net/core/rmem_max)" \
   bash deploy/train.sh --recipe "$recipe" --actors "$actors" --updates "$updates" --run-dir "$run_dir/run" \
   "${sets[@]}" --set runner.eval_every=0 > "$run_dir/train.log" 2>&1
 fps=$(awk -F, -v w="$warmup" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "fps") c = i; next }
