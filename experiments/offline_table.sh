@@ -8,7 +8,7 @@
 #       [--bc-steps N] [--iql-steps N] [--episodes 100] [--eval-seed 1000000] [--jobs N] [--threads T] \
 #       [--out DIR] [--set key=value ...]
 #   experiments/offline_table.sh --out DIR               (go on with DIR's table after a kill)
-#   experiments/offline_table.sh --summarize --out DIR   (only table.md and table.csv again)
+#   experiments/offline_table.sh --summarize --out DIR   (only table.md and table.csv, of the runs done so far)
 # Resumable: a run with its `done` file is not redone; a run whose training finished (`trained`)
 # is only evaluated again; any other run starts afresh (masa_offline has no checkpoint). Runs are
 # taken seed by seed, so a table stopped early has whole seeds of every cell.
@@ -99,8 +99,12 @@ else
   } > "$out/table.txt"
 fi
 out=$(cd "$out" && pwd)
-exec {table_lock}> "$out/.table.lock"
-flock -n "$table_lock" || { echo "offline_table.sh: another table is running in $out (wait for it, or stop it first)" >&2; exit 3; }
+# One table per directory (a second would start the same runs afresh over the first's); --summarize
+# only reads finished runs, so it may look at a table while it runs.
+if [ "$summarize" = 0 ]; then
+  exec {table_lock}> "$out/.table.lock"
+  flock -n "$table_lock" || { echo "offline_table.sh: another table is running in $out (wait for it, or stop it first)" >&2; exit 3; }
+fi
 
 # One run: train (unless trained), evaluate, write result.csv (the means over the episodes of the
 # return, the success rate, and every progress figure of eval.csv), then `done`.
@@ -197,7 +201,7 @@ summarize() {
       M = m; SD = n[key] > 1 ? sqrt(s / (n[key] - 1)) : "nan" }
     function cell(key, j, digits) {
       stat(key, j); if (M == "nan") return n[key] == 0 ? "" : "n/a"
-      return sprintf("%." digits "f", M) (SD == "nan" ? "" : sprintf(" ± %." digits "f", SD)) (n[key] < nseeds ? " (" n[key] " seeds)" : "") }
+      return sprintf("%." digits "f", M) (SD == "nan" ? "" : sprintf(" ± %." digits "f", SD)) (n[key] < nseeds ? " (" n[key] (n[key] == 1 ? " seed)" : " seeds)") : "") }
     END {
       na = split(algos, A, " "); nme = split(methods, ME, " "); nf = split(families, F, " ")
       h = "task,algo,method,family,seeds"

@@ -28,6 +28,9 @@ for _ in $(seq 600); do [ -f table/tiny/bc_sa_s0/done ] && break; sleep 0.1; don
 # The same table started twice: the second is refused while the first runs.
 "${table[@]}" > table_twice.out 2>&1 && fail "a second table on the same directory was accepted"
 grep -q "another table is running in" table_twice.out || fail "the second table did not say why: $(cat table_twice.out)"
+# --summarize may look at the running table: the finished run, its cell marked as 1 seed of 2.
+"$src/experiments/offline_table.sh" --summarize --out table > table_peek.out 2>&1 || fail "--summarize of a running table failed"
+grep -q "^| tiny | [-0-9.]* ± [0-9.]* | [-0-9.]* (1 seed) | " table/table.md || fail "the running table's table.md: $(cat table/table.md)"
 kill -TERM "$pid"
 wait "$pid" && fail "the killed table exited 0" || true
 [ -f table/tiny/bc_masa_s0/done ] && fail "masa's run finished before the kill (make the runs longer)"
