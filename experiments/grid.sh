@@ -17,6 +17,7 @@
 set -euo pipefail
 caller=$(pwd)
 cd "$(dirname "$0")/.."
+source experiments/job_queue.sh
 repo=$(pwd)
 # --out and --hosts are the caller's paths; MASA_BUILD_DIR is relative to the checkout.
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
@@ -148,26 +149,18 @@ if [ "$replot" = 0 ]; then
   worker() {
     local host=$1 line
     while :; do
-      line=$(flock "$lock" bash -c 'l=$(head -n 1 "$0"); [ -n "$l" ] && sed -i 1d "$0"; printf %s "$l"' "$queue")
+      line=$(pop_job "$queue" "$lock")
       [ -n "$line" ] || return 0
       # shellcheck disable=SC2086
       run_one "$host" $line
     done
   }
-  export -f run_one worker
+  export -f run_one worker pop_job
   for t in $tasks; do mkdir -p "$out/$t"; done
   pids=()
   # On a kill: the workers (no new runs) and their runs, which checkpoint and exit; the grid exits
   # after them, so that a rerun never meets a run still writing.
-  descendants() { local c; for c in $(pgrep -P "$1"); do echo "$c"; descendants "$c"; done; }
-  stop_all() {
-    local all=("${pids[@]}") p
-    for p in "${pids[@]}"; do mapfile -t -O "${#all[@]}" all < <(descendants "$p"); done
-    kill -TERM "${all[@]}" 2>/dev/null || true
-    for p in "${all[@]}"; do while kill -0 "$p" 2>/dev/null; do sleep 0.1; done; done
-    echo "grid.sh: stopped; run the same command again (or grid.sh --out $out) to go on" >&2
-    exit 143
-  }
+  stop_all() { stop_workers "grid.sh: stopped; run the same command again (or grid.sh --out $out) to go on" "${pids[@]}"; }
   trap stop_all INT TERM
   while read -r host; do bash -c 'worker "$0"' "$host" & pids+=($!); done < "$slots"
   wait "${pids[@]}"

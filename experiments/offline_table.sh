@@ -21,6 +21,7 @@
 set -euo pipefail
 caller=$(pwd)
 cd "$(dirname "$0")/.."
+source experiments/job_queue.sh
 repo=$(pwd)
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
 die() { echo "offline_table.sh: $*" >&2; exit 2; }
@@ -250,26 +251,18 @@ if [ "$summarize" = 0 ]; then
   worker() {
     local line
     while :; do
-      line=$(flock "$qlock" bash -c 'l=$(head -n 1 "$0"); [ -n "$l" ] && sed -i 1d "$0"; printf %s "$l"' "$queue")
+      line=$(pop_job "$queue" "$qlock")
       [ -n "$line" ] || return 0
       # shellcheck disable=SC2086
       run_one $line
     done
   }
-  export -f run_one worker
+  export -f run_one worker pop_job
   for f in $families; do mkdir -p "$out/$f"; done
   pids=()
   # On a kill: the workers and their runs end; the table exits after them, so that a rerun never
   # meets a run still writing. An unfinished run has no `done` and is redone (or only evaluated).
-  descendants() { local c; for c in $(pgrep -P "$1"); do echo "$c"; descendants "$c"; done; }
-  stop_all() {
-    local all=("${pids[@]}") p
-    for p in "${pids[@]}"; do mapfile -t -O "${#all[@]}" all < <(descendants "$p"); done
-    kill -TERM "${all[@]}" 2>/dev/null || true
-    for p in "${all[@]}"; do while kill -0 "$p" 2>/dev/null; do sleep 0.1; done; done
-    echo "offline_table.sh: stopped; run the same command again (or offline_table.sh --out $out) to go on" >&2
-    exit 143
-  }
+  stop_all() { stop_workers "offline_table.sh: stopped; run the same command again (or offline_table.sh --out $out) to go on" "${pids[@]}"; }
   trap stop_all INT TERM
   for ((i = 0; i < jobs; ++i)); do bash -c worker & pids+=($!); done
   wait "${pids[@]}"
