@@ -27,6 +27,17 @@ Rng envRng(std::uint64_t seed, int actor_id, int env) {
   return Rng(seq);
 }
 
+// A positive incarnation that a restart of the same actor (a new process, a later clock) will not
+// repeat: the clock's nanoseconds and the process id, mixed (splitmix64's finalizer).
+int64_t incarnationFromClock() {
+  uint64_t x = static_cast<uint64_t>(std::chrono::system_clock::now().time_since_epoch().count());
+  x ^= static_cast<uint64_t>(::getpid()) << 40;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  x ^= x >> 31;
+  return static_cast<int64_t>(x & 0x7fffffffffffffffULL) | 1;
+}
+
 // Runs f with the calling thread's OpenMP team size at 1, so the network's GEMM stays serial.
 template <class F>
 void singleThreaded(F&& f) {
@@ -51,10 +62,7 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
   if (options_.threads <= 0) throw std::runtime_error("actor: threads must be positive");
   if (!(options_.drop_chunks_percent >= 0.0 && options_.drop_chunks_percent <= 100.0))
     throw std::runtime_error("actor: drop_chunks_percent must be in [0, 100]");
-  if (options_.first_rollout_seq < 0 && options_.first_rollout_seq != kRolloutSeqFromClock)
-    throw std::runtime_error("actor: first_rollout_seq must be >= 0");
-  first_rollout_seq_ = options_.first_rollout_seq == kRolloutSeqFromClock ? transport::wallClockMicros()
-                                                                          : options_.first_rollout_seq;
+  incarnation_ = options_.incarnation != kIncarnationFromClock ? options_.incarnation : incarnationFromClock();
   drop_rng_.seed(options_.drop_seed);
 
   const auto spec = sym::SymmetrySpec::load(config_.spec_path);
@@ -298,7 +306,8 @@ bool Actor::collectAndPublish() {
   RolloutIdentity id;
   id.run_id = options_.run_id;
   id.actor_id = options_.actor_id;
-  id.rollout_seq = first_rollout_seq_ + rollouts_sent_;
+  id.incarnation = incarnation_;
+  id.rollout_seq = rollouts_sent_;
   id.policy_version = acting_version;
   std::uniform_real_distribution<double> percent(0.0, 100.0);
   for (const auto& chunk : chunker_.split(rollout_, id)) {

@@ -29,8 +29,8 @@
 
 namespace masa::actor {
 
-// ActorOptions::first_rollout_seq: number rollouts from the wall clock (see there).
-inline constexpr int64_t kRolloutSeqFromClock = -1;
+// ActorOptions::incarnation: pick one from the clock and the process id (see there).
+inline constexpr int64_t kIncarnationFromClock = 0;
 
 struct ActorOptions {
   int actor_id = 0;
@@ -45,11 +45,11 @@ struct ActorOptions {
   bool start_without_learner = false;  // act with own initial parameters as version 0
   double heartbeat_interval_s = 1.0;
   int chunk_bytes = kDefaultChunkBytes;
-  // rollout_seq of the first rollout, +1 per rollout after it. kRolloutSeqFromClock: the wall clock
-  // in microseconds when the actor is made, so that an actor restarted with the same id numbers
-  // its rollouts far past its previous process's (the learner's duplicate filter would otherwise
-  // take them for replays) and the numbering jump tells the learner it restarted.
-  int64_t first_rollout_seq = kRolloutSeqFromClock;
+  // This process's incarnation (lcmt_rollout_chunk.incarnation): an actor restarted with the same
+  // id must differ from its previous process, so that the learner takes its rollouts, numbered from
+  // 0 again, for a restart and not for replays. kIncarnationFromClock: mixed from the wall clock
+  // and the process id. Tests fix it for bit-identical chunks; it changes no random draw.
+  int64_t incarnation = kIncarnationFromClock;
   // Fault injection for tests, off by default: this percentage of chunks is counted and thrown
   // away instead of published, chosen by a generator seeded with drop_seed (reproducible).
   double drop_chunks_percent = 0.0;
@@ -81,7 +81,7 @@ struct ActorOptions {
   double reject_warning_interval_s = 5.0;
   const std::atomic<bool>* stop = nullptr;  // checked between steps (signal handlers set it)
   // Test hook: called after each step t of a rollout (rollout_index counts this actor's rollouts
-  // from 0, whatever first_rollout_seq is), before incoming messages are handled.
+  // from 0, as rollout_seq does), before incoming messages are handled.
   std::function<void(int64_t rollout_index, int t)> after_step;
 };
 
@@ -108,7 +108,7 @@ class Actor {
   bool hasParams() const { return version_ >= 0; }
   int64_t policyVersion() const { return version_; }
   int64_t rolloutsSent() const { return rollouts_sent_; }
-  int64_t firstRolloutSeq() const { return first_rollout_seq_; }
+  int64_t incarnation() const { return incarnation_; }
   int64_t chunksPublished() const { return chunks_published_; }
   int64_t chunksDropped() const { return chunks_dropped_; }  // by drop_chunks_percent
   int64_t paramsRejected() const { return params_rejected_; }
@@ -170,7 +170,7 @@ class Actor {
   double last_reject_warning_s_ = -1e300;
 
   int64_t rollouts_sent_ = 0;
-  int64_t first_rollout_seq_ = 0;
+  int64_t incarnation_ = 0;
   int64_t chunks_published_ = 0;
   int64_t chunks_dropped_ = 0;
   Rng drop_rng_;

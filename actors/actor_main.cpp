@@ -57,10 +57,10 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_flag("--start-without-learner", opt.start_without_learner,
                "act with own initial parameters (version 0) instead of waiting for the learner");
-  app.add_option("--first-rollout-seq", opt.first_rollout_seq,
-                 "rollout_seq of the first rollout (default: the wall clock in microseconds, so a restarted "
-                 "actor's rollouts are told apart from its previous process's)")
-      ->check(CLI::NonNegativeNumber);
+  app.add_option("--incarnation", opt.incarnation,
+                 "this process's incarnation in its rollout chunks (default: from the clock and the process id, so "
+                 "that the learner tells a restarted actor's rollouts from its previous process's)")
+      ->check(CLI::PositiveNumber);
   std::string key_file;
   bool no_auth = false;
   auto* key_opt = app.add_option("--key-file", key_file,
@@ -101,8 +101,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "masa_actor %d: FAULT INJECTION: throwing away %g%% of rollout chunks (seed %llu)\n",
                    opt.actor_id, opt.drop_chunks_percent, static_cast<unsigned long long>(opt.drop_seed));
     const auto sent = actor.run();
-    std::fprintf(stderr, "masa_actor %d: stopped after %lld rollouts (numbered from %lld), %lld chunks sent", opt.actor_id,
-                 static_cast<long long>(sent), static_cast<long long>(actor.firstRolloutSeq()),
+    std::fprintf(stderr, "masa_actor %d: stopped after %lld rollouts (incarnation %lld), %lld chunks sent", opt.actor_id,
+                 static_cast<long long>(sent), static_cast<long long>(actor.incarnation()),
                  static_cast<long long>(actor.chunksPublished()));
     if (opt.drop_chunks_percent > 0)
       std::fprintf(stderr, ", %lld thrown away by fault injection", static_cast<long long>(actor.chunksDropped()));

@@ -144,6 +144,7 @@ void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const rollout::Rollout& r
   const int E = r.num_envs, T = r.horizon;
   c.run_id = id.run_id;
   c.actor_id = id.actor_id;
+  c.incarnation = id.incarnation;
   c.rollout_seq = id.rollout_seq;
   c.chunk_index = index;
   c.num_chunks = num_chunks;

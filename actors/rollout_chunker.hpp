@@ -27,6 +27,7 @@ struct RolloutIdentity {
   int32_t actor_id = 0;
   int64_t rollout_seq = 0;
   int64_t policy_version = 0;
+  int64_t incarnation = 0;  // the actor process (lcmt_rollout_chunk.incarnation)
 };
 
 class RolloutChunker {

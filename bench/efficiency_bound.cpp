@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
     ao.num_envs = rc.ppo.num_envs;
     ao.run_id = 1;
     ao.threads = 1;
-    ao.first_rollout_seq = 0;
+    ao.incarnation = 1;  // bit-identical chunks from run to run
     ao.heartbeat_interval_s = 1e9;
     masa::actor::Actor actor(rc, ao, &learner.transport());
     const double steps = static_cast<double>(rc.ppo.num_envs) * rc.ppo.horizon;

@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
     ao.num_envs = rc.ppo.num_envs;
     ao.run_id = lo.run_id;
     ao.threads = threads;
-    ao.first_rollout_seq = 0;
+    ao.incarnation = 1;  // bit-identical chunks from run to run
     ao.heartbeat_interval_s = 1e9;  // nobody listens
     ao.stop = &g_stop;
     masa::actor::Actor actor(rc, ao, &learner.transport());

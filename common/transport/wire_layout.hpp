@@ -95,6 +95,7 @@ struct WireLayoutOf<masa::lcmt_rollout_chunk> {
   static constexpr WireField fields[] = {
       {"run_id", WireType::kInt64},
       {"actor_id", WireType::kInt32},
+      {"incarnation", WireType::kInt64},
       {"rollout_seq", WireType::kInt64},
       {"chunk_index", WireType::kInt32},
       {"num_chunks", WireType::kInt32},

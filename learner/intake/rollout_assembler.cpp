@@ -70,7 +70,6 @@ RolloutAssembler::RolloutAssembler(const AssemblerConfig& config) : cfg_(config)
              "assembler limits must be positive");
   MASA_CHECK(cfg_.loss_horizon >= 1 && cfg_.loss_horizon <= cfg_.dedup_window,
              "loss_horizon must be in [1, dedup_window]");
-  MASA_CHECK(cfg_.max_rollout_gap >= 2 * cfg_.dedup_window, "max_rollout_gap must be at least 2 * dedup_window");
 }
 
 DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
@@ -175,18 +174,19 @@ void RolloutAssembler::closeRollouts(ActorWindow& a, int actor_id, int64_t upto)
   }
 }
 
-void RolloutAssembler::startNumbering(ActorWindow& a, int actor_id, int64_t seq) {
+void RolloutAssembler::startNumbering(ActorWindow& a, int actor_id, int64_t incarnation, int64_t seq) {
   const bool restart = a.first >= 0;
   if (restart) closeRollouts(a, actor_id, a.newest);  // the old numbering's last rollouts are final now
   if (cfg_.warn_interval_s >= 0) {
     if (restart) {
-      std::cerr << "masa transport: actor " << actor_id << " restarted (rollout numbering jumped from " << a.newest
-                << " to " << seq << "): a new numbering, not replays\n";
+      std::cerr << "masa transport: actor " << actor_id << " restarted (incarnation " << incarnation << " after "
+                << a.incarnation << ", at its rollout " << seq << "): a new numbering, not replays\n";
     } else {
       std::cerr << "masa transport: actor " << actor_id << " joined\n";
     }
   }
   for (SeenRollout& r : a.rollouts) r.seq = -1;
+  a.incarnation = incarnation;
   a.first = a.newest = seq;
   a.closed = seq - 1;
   ++a.tally.numberings;
@@ -234,11 +234,12 @@ RolloutAssembler::SeenRollout& RolloutAssembler::claimSlot(ActorWindow& a, int64
 DropReason RolloutAssembler::markAccepted(const masa::lcmt_rollout_chunk& m) {
   ActorWindow& a = windowOf(m.actor_id);
   const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
-  if (a.first < 0) startNumbering(a, m.actor_id, s);  // first sight
+  if (a.first < 0) startNumbering(a, m.actor_id, m.incarnation, s);  // first sight
+  if (m.incarnation != a.incarnation) return acceptFarChunk(a, m);
 
   SeenRollout* slot = findSlot(a, s);
   if (slot == nullptr) {
-    if (s > a.newest + w || s < a.newest - 2 * w) return acceptFarChunk(a, m);
+    if (s > a.newest + w) return acceptFarChunk(a, m);
     if (s <= a.newest - w) return DropReason::kDuplicate;  // behind the window: a replay or a straggler we can no longer check
     if (s > a.newest) {
       a.candidate.seq = -1;  // the numbering moved on: a far rollout seen before it was not a restart
@@ -270,13 +271,14 @@ DropReason RolloutAssembler::markAccepted(const masa::lcmt_rollout_chunk& m) {
 DropReason RolloutAssembler::acceptFarChunk(ActorWindow& a, const masa::lcmt_rollout_chunk& m) {
   SeenRollout& c = a.candidate;
   const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
-  if (c.seq >= 0 && s > c.seq && s <= c.seq + w) {
-    // The far rollout's successor, with no progress of the current numbering in between: an
-    // outage that lost the rollouts in the gap, or a restarted actor.
+  const bool same_candidate = c.seq >= 0 && a.candidate_incarnation == m.incarnation;
+  if (same_candidate && s > c.seq && s <= c.seq + w) {
+    // The far rollout's successor, with no progress of the current numbering in between: a
+    // restarted actor (another incarnation), or an outage that lost the rollouts in the gap.
     SeenRollout far = std::move(c);
     c.seq = -1;
-    if (far.seq > a.newest + cfg_.max_rollout_gap || far.seq < a.newest - 2 * w) {
-      startNumbering(a, m.actor_id, far.seq);
+    if (m.incarnation != a.incarnation) {
+      startNumbering(a, m.actor_id, m.incarnation, far.seq);
     } else {
       closeRollouts(a, m.actor_id, far.seq - cfg_.loss_horizon);
       a.newest = far.seq;
@@ -285,7 +287,10 @@ DropReason RolloutAssembler::acceptFarChunk(ActorWindow& a, const masa::lcmt_rol
     claimSlot(a, far.seq, far.num_chunks) = std::move(far);
     return markAccepted(m);  // within the window now
   }
-  if (c.seq != s || c.num_chunks != m.num_chunks) resetSlot(c, s, m.num_chunks);  // replaces an unconfirmed one
+  if (!same_candidate || c.seq != s || c.num_chunks != m.num_chunks) {  // replaces an unconfirmed one
+    resetSlot(c, s, m.num_chunks);
+    a.candidate_incarnation = m.incarnation;
+  }
   const std::size_t w64 = m.chunk_index / 64;
   const uint64_t bit = uint64_t{1} << (m.chunk_index % 64);
   if (c.bits[w64] & bit) return DropReason::kDuplicate;
@@ -298,7 +303,7 @@ void RolloutAssembler::markArrived(const masa::lcmt_rollout_chunk& m) {
   if (m.actor_id >= static_cast<int>(actors_.size())) return;  // an actor never accepted: nothing to follow
   ActorWindow& a = actors_[m.actor_id];
   const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
-  if (a.first < 0 || s <= a.newest - w || s > a.newest + w) return;
+  if (a.first < 0 || m.incarnation != a.incarnation || s <= a.newest - w || s > a.newest + w) return;
   SeenRollout* slot = findSlot(a, s);
   if (slot == nullptr) {
     slot = &claimSlot(a, s, m.num_chunks);

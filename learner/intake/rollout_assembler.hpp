@@ -7,17 +7,18 @@
 // environments, so a rollout whose other chunks were lost still delivers the environments that
 // arrived, and nothing ever waits for a missing chunk.
 //
-// Per actor it follows the rollout numbering (rollout_seq): duplicates are detected within the last
-// dedup_window rollouts, and chunks that never arrived are counted as kLost once the actor is
-// loss_horizon rollouts past their rollout (a wholly lost rollout counts as many chunks as the
-// actor's last rollout had). Only an accepted chunk moves this bookkeeping; a chunk dropped as out
-// of date only marks its rollout's chunk as arrived (so that it is not also counted lost), and only
-// within the window. An accepted chunk far from the numbering (more than dedup_window ahead, or
-// more than 2 * dedup_window behind) is used, but believed only when its actor's next rollout
-// follows it before the current numbering moves on: then it is an outage (the gap is lost) or, past
-// max_rollout_gap ahead or behind the window, a restarted actor (masa_actor numbers from its start
-// time in microseconds, so a restart jumps millions ahead). A replayed chunk, or a copy of a live
-// one with a wild number, therefore neither counts chunks lost nor reports a restart.
+// Per actor it follows one incarnation (the actor process) and its rollout numbering (rollout_seq,
+// from 0): duplicates are detected within the last dedup_window rollouts, and chunks that never
+// arrived are counted as kLost once the actor is loss_horizon rollouts past their rollout (a wholly
+// lost rollout counts as many chunks as the actor's last rollout had). Only an accepted chunk moves
+// this bookkeeping; a chunk dropped as out of date only marks its rollout's chunk as arrived (so
+// that it is not also counted lost), and only within the window. Rollouts behind the window are
+// duplicates. An accepted chunk of another incarnation, or more than dedup_window ahead of the
+// numbering, is used, but believed only when its actor's next rollout follows it before the
+// current numbering moves on: then it is a restarted actor (another incarnation: a new numbering)
+// or an outage (the gap is lost). Restarts rest on the incarnation alone, never on the numbering.
+// A replayed chunk, or a copy of a live one with a wild number, therefore neither counts chunks
+// lost nor reports a restart.
 #pragma once
 
 #include <chrono>
@@ -42,7 +43,6 @@ struct AssemblerConfig {
   int max_terms = 256;               // num_terms must not exceed
   int dedup_window = 16;             // rollouts per actor remembered to detect duplicates
   int loss_horizon = 2;              // rollouts an actor must be past a rollout before its gaps count as lost
-  int max_rollout_gap = 4096;        // a longer jump ahead is a new numbering, a shorter one lost rollouts
   double warn_interval_s = 5.0;      // at most one warning per reason per interval; < 0: silent
 };
 
@@ -108,7 +108,9 @@ class RolloutAssembler {
     int64_t newest = -1;                // newest rollout seen in it
     int64_t closed = -1;                // rollouts up to this one have had their losses counted
     int32_t num_chunks = 0;             // chunks per rollout, as last seen
+    int64_t incarnation = 0;            // of the current numbering
     SeenRollout candidate;              // an accepted rollout far from the numbering, not yet believed
+    int64_t candidate_incarnation = 0;  // ... and its incarnation
     ActorTally tally;
   };
 
@@ -119,14 +121,15 @@ class RolloutAssembler {
   // Notes that a well-formed but out-of-date chunk arrived, so that it is not counted lost; moves
   // nothing else, and nothing at all outside the actor's window.
   void markArrived(const masa::lcmt_rollout_chunk& m);
-  // An accepted chunk far from the numbering: held as a candidate until its next rollout confirms it.
+  // An accepted chunk far from the numbering, or of another incarnation: held as a candidate until
+  // its next rollout confirms it.
   DropReason acceptFarChunk(ActorWindow& a, const masa::lcmt_rollout_chunk& m);
   ActorWindow& windowOf(int actor_id);
   SeenRollout* findSlot(ActorWindow& a, int64_t seq);
   SeenRollout& claimSlot(ActorWindow& a, int64_t seq, int32_t num_chunks);  // replaces the oldest
   // Counts the missing chunks of rollouts (closed, upto] of the current numbering.
   void closeRollouts(ActorWindow& a, int actor_id, int64_t upto);
-  void startNumbering(ActorWindow& a, int actor_id, int64_t seq);
+  void startNumbering(ActorWindow& a, int actor_id, int64_t incarnation, int64_t seq);
   Verdict finish(DropReason reason, const masa::lcmt_rollout_chunk* m);
   bool warnDue(DropReason reason);
 

@@ -54,7 +54,7 @@ fuzzed_run() {
   accepted=$(sed -n 's/^masa_learner: rollout chunks accepted \([0-9][0-9]*\).*/\1/p' "$learner_log")
   actor_chunks=0
   for a in 0 1; do
-    n=$(sed -n 's/.*rollouts (numbered from [0-9]*), \([0-9][0-9]*\) chunks sent.*/\1/p' "$work/actor$a.log" | tail -1)
+    n=$(sed -n 's/.*rollouts (incarnation [0-9]*), \([0-9][0-9]*\) chunks sent.*/\1/p' "$work/actor$a.log" | tail -1)
     actor_chunks=$((actor_chunks + ${n:-0}))
   done
   # The actors' logs are appended across both runs: keep each run's.

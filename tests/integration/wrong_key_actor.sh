@@ -39,7 +39,7 @@ for a in 1 2; do
 done
 sent=0
 for a in 1 2; do
-  n=$(sed -n 's/.*rollouts (numbered from [0-9]*), \([0-9][0-9]*\) chunks sent.*/\1/p' "$work/actor$a.log" | tail -1)
+  n=$(sed -n 's/.*rollouts (incarnation [0-9]*), \([0-9][0-9]*\) chunks sent.*/\1/p' "$work/actor$a.log" | tail -1)
   [ -n "$n" ] && [ "$n" -gt 0 ] || fail "actor $a sent no chunk: nothing was tried"
   sent=$((sent + n))
 done

@@ -49,12 +49,12 @@ CollectorConfig collectorConfig(int num_envs, int lag = 0) {
 
 // A rollout of 20 TriFinger environments split 4 per chunk (5 chunks), with truncations and
 // episodes in every chunk so their validation is exercised.
-std::vector<masa::lcmt_rollout_chunk> makeChunks(int64_t version, int64_t seq = 0, int actor = 0) {
+std::vector<masa::lcmt_rollout_chunk> makeChunks(int64_t version, int64_t seq = 0, int actor = 0, int64_t incarnation = 1) {
   rollout::Rollout r;
   fillRandomRollout(r, kTrifinger, 100 + seq, 0.1);
   RolloutChunker chunker(4 * RolloutChunker::envBytes(kTrifinger.horizon, kTrifinger.obs_dim, kTrifinger.act_dim) + 3000);
   const auto span = chunker.split(r, RolloutIdentity{.run_id = kRun, .actor_id = actor, .rollout_seq = seq,
-                                                     .policy_version = version});
+                                                     .policy_version = version, .incarnation = incarnation});
   return {span.begin(), span.end()};
 }
 
@@ -216,38 +216,37 @@ TEST(RolloutAssembler, DuplicateChunkOfAnOlderRolloutIsDroppedButOtherActorsAreI
   EXPECT_EQ(assembler.accept(odd).reason, DropReason::kOutOfRange);
 }
 
-// masa_actor numbers rollouts from its start time in microseconds; a restart with the same actor id
-// therefore jumps far ahead of what its previous process sent.
-TEST(RolloutAssembler, RestartedActorIsAcceptedAtOnceAndItsJumpCountsAsANewNumbering) {
+// A restarted actor (same actor id, a new process) is a new incarnation, numbering its rollouts from
+// 0 again: its rollouts are used at once, not taken for replays of the dead process's, and it counts
+// as a new numbering once its second rollout follows. Restarts rest on the incarnation alone.
+TEST(RolloutAssembler, ARestartedActorIsANewIncarnationAndIsAcceptedAtOnce) {
   RolloutAssembler assembler(assemblerConfig());
-  const int64_t first_start = 1'700'000'000'000'000;  // microseconds since the epoch
   int64_t sent = 0;
   for (int64_t k = 0; k < 5; ++k)  // fewer rollouts than the dedup window remembers
-    for (const auto& c : makeChunks(0, first_start + k)) {
+    for (const auto& c : makeChunks(0, k, 0, /*incarnation=*/11)) {
       ASSERT_TRUE(assembler.accept(c));
       ++sent;
     }
-  // Killed, restarted 3 s later: every chunk of every rollout of the new process goes through.
-  const int64_t second_start = first_start + 3'000'000;
-  for (int64_t k = 0; k < 5; ++k)
-    for (const auto& c : makeChunks(0, second_start + k)) {
+  // Killed and restarted: every chunk of every rollout of the new process goes through.
+  for (int64_t k = 0; k < 5; ++k) {
+    for (const auto& c : makeChunks(0, k, 0, /*incarnation=*/22)) {
       const Verdict v = assembler.accept(c);
       EXPECT_TRUE(v) << "rollout " << k << " of the restarted actor: " << dropReasonName(v.reason);
       ++sent;
     }
+    if (k == 0) EXPECT_EQ(assembler.actorTally(0).numberings, 1) << "one rollout alone may be a replay or a forgery";
+  }
   EXPECT_EQ(assembler.stats()[DropReason::kAccepted], sent);
   EXPECT_EQ(assembler.stats().dropped(), 0) << "nothing dropped, nothing counted lost";
   EXPECT_EQ(assembler.actorTally(0).numberings, 2);
   EXPECT_EQ(assembler.actorTally(0).accepted, sent);
   // Duplicates are still caught within the new numbering.
-  EXPECT_EQ(assembler.accept(makeChunks(0, second_start + 4)[0]).reason, DropReason::kDuplicate);
-  // A clock stepped back by more than the window is a new numbering as well, not a replay: its
-  // chunks are used at once, and it counts as a numbering once its second rollout follows.
-  for (const auto& c : makeChunks(0, first_start - 1'000'000)) EXPECT_TRUE(assembler.accept(c));
-  EXPECT_EQ(assembler.actorTally(0).numberings, 2) << "one far rollout alone may be a replay or a forgery";
-  for (const auto& c : makeChunks(0, first_start - 1'000'000 + 1)) EXPECT_TRUE(assembler.accept(c));
-  EXPECT_EQ(assembler.actorTally(0).numberings, 3);
-  EXPECT_EQ(assembler.stats()[DropReason::kLost], 0);
+  EXPECT_EQ(assembler.accept(makeChunks(0, 4, 0, 22)[0]).reason, DropReason::kDuplicate);
+  // A jump far ahead within one incarnation is an outage, never a restart.
+  for (int64_t k : {5000, 5001})
+    for (const auto& c : makeChunks(0, k, 0, 22)) EXPECT_TRUE(assembler.accept(c));
+  EXPECT_EQ(assembler.actorTally(0).numberings, 2);
+  EXPECT_GT(assembler.stats()[DropReason::kLost], 0) << "the rollouts of the outage";
 }
 
 // A replaying or fuzzing host on the LAN: old chunks sent again, and copies of live chunks with
@@ -255,7 +254,7 @@ TEST(RolloutAssembler, RestartedActorIsAcceptedAtOnceAndItsJumpCountsAsANewNumbe
 // actor's numbering: no chunk counted lost, no restart reported.
 TEST(RolloutAssembler, ReplayedChunksAndWildRolloutNumbersChangeNeitherLostNorRestarts) {
   RolloutAssembler assembler(assemblerConfig(/*lag=*/1));
-  const int64_t start = 1'700'000'000'000'000;
+  const int64_t start = 0;
   const int kRollouts = 40;  // well past twice the dedup window
   std::vector<std::vector<masa::lcmt_rollout_chunk>> sent;
   for (int k = 0; k < kRollouts; ++k) {
@@ -287,6 +286,16 @@ TEST(RolloutAssembler, ReplayedChunksAndWildRolloutNumbersChangeNeitherLostNorRe
   }
   EXPECT_EQ(assembler.stats()[DropReason::kLost], 0) << "wild rollout numbers";
   EXPECT_EQ(assembler.actorTally(0).numberings, 1) << "wild rollout numbers";
+  // ... and with wild incarnations: each is one rollout of a would-be restart, never confirmed.
+  for (int64_t wild : {int64_t{2}, int64_t{0}, int64_t{-1}, int64_t{1} << 62, int64_t{12345}}) {
+    for (masa::lcmt_rollout_chunk c : sent.back()) {
+      c.incarnation = wild;
+      c.policy_version = kRollouts - 1;
+      assembler.accept(c);
+    }
+  }
+  EXPECT_EQ(assembler.stats()[DropReason::kLost], 0) << "wild incarnations";
+  EXPECT_EQ(assembler.actorTally(0).numberings, 1) << "wild incarnations";
 
   // The real actor goes on: its next rollouts are accepted, nothing is lost.
   for (int k = kRollouts; k < kRollouts + 3; ++k) {
@@ -297,9 +306,10 @@ TEST(RolloutAssembler, ReplayedChunksAndWildRolloutNumbersChangeNeitherLostNorRe
   EXPECT_EQ(assembler.actorTally(0).numberings, 1);
 }
 
-TEST(RolloutAssembler, ARestartThatReusedItsNumberingWouldBeTakenForReplays) {
-  // Why masa_actor does not number from 0: a restarted process's first rollouts would collide
-  // with the dead one's, within the window, and be dropped as duplicates.
+TEST(RolloutAssembler, ARestartThatKeptItsIncarnationWouldBeTakenForReplays) {
+  // Why every masa_actor process picks a new incarnation: a restarted process's first rollouts,
+  // numbered from 0, would collide with the dead one's, within the window, and be dropped as
+  // duplicates.
   RolloutAssembler assembler(assemblerConfig());
   for (int64_t k = 0; k < 5; ++k)
     for (const auto& c : makeChunks(0, k)) ASSERT_TRUE(assembler.accept(c));
@@ -359,16 +369,20 @@ TEST(RolloutAssembler, MalformedBytesAreDroppedWithoutDecodingHostileLengths) {
   // Truncated datagram.
   EXPECT_EQ(assembler.acceptEncoded(bytes.data(), static_cast<int>(bytes.size()) - 10).reason,
             DropReason::kMalformed);
-  // obs_len = 2^31 - 1: the generated decoder would allocate 8 GB before noticing.
+  // obs_len = 2^31 - 1: the generated decoder would allocate 8 GB before noticing. Its offset: the
+  // hash, run_id, actor_id, incarnation, rollout_seq, chunk_index, num_chunks, policy_version and
+  // the five int32 dimensions before it.
+  constexpr int kObsLen = 8 + 8 + 4 + 8 + 8 + 4 + 4 + 8 + 5 * 4;
+  ASSERT_EQ(bytes[kObsLen + 3] + 256 * bytes[kObsLen + 2], static_cast<int>(chunks[0].obs_len) % 65536);
   std::vector<uint8_t> huge = bytes;
-  huge[64] = 0x7f;
-  huge[65] = huge[66] = huge[67] = 0xff;
+  huge[kObsLen] = 0x7f;
+  huge[kObsLen + 1] = huge[kObsLen + 2] = huge[kObsLen + 3] = 0xff;
   const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(assembler.acceptEncoded(huge.data(), static_cast<int>(huge.size())).reason, DropReason::kMalformed);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(100));
   // Negative length.
   std::vector<uint8_t> negative = bytes;
-  negative[64] = 0x80;
+  negative[kObsLen] = 0x80;
   EXPECT_EQ(assembler.acceptEncoded(negative.data(), static_cast<int>(negative.size())).reason,
             DropReason::kMalformed);
   EXPECT_EQ(assembler.acceptEncoded(nullptr, 0).reason, DropReason::kMalformed);

@@ -189,10 +189,11 @@ TEST(ChunkWireGuard, AcceptsEncodedChunksAndRejectsEveryTruncationOrLengthPastTh
   std::vector<uint8_t> longer = bytes;
   longer.push_back(0);
   EXPECT_FALSE(chunkWireLengthsFit(longer.data(), static_cast<int>(longer.size())));
-  // obs_len sits right after the hash and the 56-byte header: claim 2^31 - 1 floats.
+  // obs_len sits right after the hash and the 64-byte header: claim 2^31 - 1 floats.
   std::vector<uint8_t> huge = bytes;
-  huge[64] = 0x7f;
-  huge[65] = huge[66] = huge[67] = 0xff;
+  ASSERT_EQ((bytes[72] << 24) | (bytes[73] << 16) | (bytes[74] << 8) | bytes[75], chunks[0].obs_len);
+  huge[72] = 0x7f;
+  huge[73] = huge[74] = huge[75] = 0xff;
   EXPECT_FALSE(chunkWireLengthsFit(huge.data(), static_cast<int>(huge.size())));
   std::vector<uint8_t> other_hash = bytes;
   other_hash[0] ^= 1;
