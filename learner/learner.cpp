@@ -1,5 +1,6 @@
 #include "learner/learner.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <omp.h>
 #include <cstdio>
@@ -61,7 +62,9 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
     : rc_(rc),
       opt_(options),
       dir_(options.run_dir),
-      rng_(rc.seed) {
+      rng_(rc.seed),
+      round_(rc.runner.loss_grace_s),
+      min_batch_envs_(static_cast<int>(std::ceil(rc.runner.min_batch_fraction * rc.ppo.num_envs))) {
   MASA_CHECK(!dir_.empty(), "learner: no run directory");
   fs::create_directories(dir_);
   const auto spec = sym::SymmetrySpec::load(rc_.spec_path);
@@ -70,6 +73,10 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   nn::AdamConfig<float> adam_cfg;
   adam_cfg.lr = static_cast<float>(rc_.ppo.learning_rate);
   adam_ = std::make_unique<nn::Adam<float>>(model_->params(), adam_cfg);
+  const int64_t batch_samples = static_cast<int64_t>(rc_.ppo.num_envs) * rc_.ppo.horizon;
+  MASA_CHECK(batch_samples % rc_.ppo.minibatch_size == 0,
+             "ppo.minibatch_size " << rc_.ppo.minibatch_size << " must divide the batch, ppo.num_envs x ppo.horizon = "
+                                   << batch_samples);
   trainer_ = std::make_unique<ppo::PpoTrainer>(*model_, *adam_, rc_.ppo);
   buffer_ = std::make_unique<ppo::RolloutBuffer>(rc_.ppo.num_envs, rc_.ppo.horizon, model_->obsDim(), model_->actDim());
 
@@ -133,7 +140,9 @@ void Learner::onChunk(const void* data, int size) {
   const Verdict v = assembler_->acceptEncoded(data, size);
   if (!v) return;  // counted by the assembler
   const auto& m = v.chunk->msg();
-  silence_->heard(m.actor_id, std::chrono::steady_clock::now());
+  const auto now = std::chrono::steady_clock::now();
+  silence_->heard(m.actor_id, now);
+  round_.chunkArrived(m.actor_id, m.rollout_seq, m.chunk_index, m.num_chunks, now);
   if (!collector_) {
     CollectorConfig c;
     c.num_envs = rc_.ppo.num_envs;
@@ -149,12 +158,24 @@ void Learner::onChunk(const void* data, int size) {
   collector_->add(*v.chunk);
 }
 
+int Learner::waitMs(int timeout_ms) const {
+  if (!collector_ || collector_->ready() || collector_->bufferedEnvs() < min_batch_envs_) return timeout_ms;
+  const auto due = round_.nextDeadline();
+  if (due == std::chrono::steady_clock::time_point::max()) return timeout_ms;
+  const double ms = std::chrono::duration<double, std::milli>(due - std::chrono::steady_clock::now()).count();
+  return static_cast<int>(std::clamp(std::ceil(ms), 0.0, static_cast<double>(timeout_ms)));
+}
+
 bool Learner::step(int timeout_ms) {
-  transport_->handleTimeout(timeout_ms);
+  transport_->handleTimeout(waitMs(timeout_ms));
   transport_->drain();
   bool updated = false;
   if (collector_ && collector_->take(*buffer_)) {
     update();
+    updated = true;
+  } else if (collector_ && collector_->bufferedEnvs() >= min_batch_envs_ &&
+             round_.settled(std::chrono::steady_clock::now()) && collector_->takeShort(*buffer_, min_batch_envs_)) {
+    update();  // the missing environments were lost: waiting would not bring them
     updated = true;
   }
   const auto now = std::chrono::steady_clock::now();
@@ -203,6 +224,7 @@ void Learner::update() {
 
   assembler_->setLearnerVersion(updates_);
   collector_->setLearnerVersion(updates_);
+  round_.newRound();
   publishParams();
   report();
   if (rc_.runner.checkpoint_every > 0 && updates_ % rc_.runner.checkpoint_every == 0) writeCheckpoint();

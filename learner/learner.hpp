@@ -27,6 +27,7 @@
 #include "common/transport/transport.hpp"
 #include "learner/intake/batch_collector.hpp"
 #include "learner/intake/rollout_assembler.hpp"
+#include "learner/intake/round_tracker.hpp"
 #include "learner/learning_curve.hpp"
 #include "learner/update_report.hpp"
 #include "learner/ppo/ppo_trainer.hpp"
@@ -84,10 +85,14 @@ class Learner {
   // collector dropped (stale or overflowing its pool).
   int64_t droppedChunks() const;
   int64_t droppedEnvs() const;
+  // Updates that ran on a batch short of lost environments (runner.min_batch_fraction).
+  int64_t shortBatches() const { return collector_ ? collector_->stats().short_batches : 0; }
   const UpdateReport& lastReport() const { return report_; }
 
  private:
   void onChunk(const void* data, int size);
+  // How long step() may wait for traffic: at most timeout_ms, less when a short batch comes due sooner.
+  int waitMs(int timeout_ms) const;
   void update();
   // Tells the update: the stats message, metrics.csv, the curve, the progress line.
   void report();
@@ -111,6 +116,8 @@ class Learner {
   std::unique_ptr<SilenceWatch> silence_;
   // Made on the first accepted chunk: the reward term names come from the actors' task.
   std::unique_ptr<BatchCollector> collector_;
+  RoundTracker round_;   // when a batch may form short of lost chunks
+  int min_batch_envs_;   // the fewest environments a short batch may have (> ppo.num_envs: never short)
 
   int64_t updates_ = 0, env_steps_ = 0;
   double wall_offset_s_ = 0;  // wall time of the runs before a resume

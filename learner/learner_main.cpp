@@ -107,6 +107,7 @@ int main(int argc, char** argv) {
       if (drops[reason] > 0) std::cout << ", " << masa::learner::dropReasonName(reason) << " " << drops[reason];
     }
     std::cout << std::endl;
+    std::cout << "masa_learner: updates on batches short of lost environments " << learner.shortBatches() << std::endl;
     std::cout << "masa_learner: other messages rejected before decoding: " << learner.transport().rejectSummary()
               << std::endl;
   } catch (const std::exception& e) {

@@ -324,6 +324,11 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   u.eval_episodes = r.atLeast("runner.eval_episodes", 1);
   u.silence_warn_s = r.nonNegative("runner.silence_warn_s");
   u.snapshot_every = r.atLeast("runner.snapshot_every", 0);
+  u.min_batch_fraction = r.positive("runner.min_batch_fraction");
+  if (u.min_batch_fraction > 1.0)
+    throw ConfigError(r.originOf("runner.min_batch_fraction"), "runner.min_batch_fraction",
+                      "must be in (0, 1], got " + std::to_string(u.min_batch_fraction));
+  u.loss_grace_s = r.positive("runner.loss_grace_s");
 
   rc.env = YAML::Clone(merged["env"]);
   rc.resolved = merged;

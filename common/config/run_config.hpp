@@ -49,6 +49,10 @@ struct RunnerConfig {
   int eval_episodes = 8;           // episodes per evaluation
   double silence_warn_s = 30.0;    // seconds without rollout data before the learner says so (0: never)
   int snapshot_every = 0;          // updates between kept policies/policy_uNNNNNN.bin (0: none)
+  // A batch short of lost environments forms once this share of ppo.num_envs arrived and the rest
+  // is known lost (learner/intake/round_tracker.hpp); 1: batches are always full.
+  double min_batch_fraction = 0.5;
+  double loss_grace_s = 0.01;  // seconds after a rollout's latest chunk before its missing ones count as lost
 };
 
 struct RunConfig {

@@ -165,11 +165,25 @@ void BatchCollector::add(const ValidatedChunk& chunk) {
 
 bool BatchCollector::take(ppo::RolloutBuffer& out, BatchOrigin* origin) {
   if (!ready()) return false;
-  const int B = cfg_.num_envs, T = cfg_.horizon, od = cfg_.obs_dim, ad = cfg_.act_dim, C = capacity_;
-  MASA_CHECK(out.numEnvs() == B && out.horizon() == T && out.obsDim() == od && out.actDim() == ad,
-             "rollout buffer is " << out.numEnvs() << " envs x " << out.horizon() << " steps, obs " << out.obsDim()
-                                  << ", act " << out.actDim() << "; the collector's batches are " << B << " x " << T
-                                  << ", obs " << od << ", act " << ad);
+  takeEnvs(out, cfg_.num_envs, origin);
+  return true;
+}
+
+bool BatchCollector::takeShort(ppo::RolloutBuffer& out, int min_envs, BatchOrigin* origin) {
+  MASA_CHECK(min_envs > 0, "a short batch needs at least one environment, asked for " << min_envs);
+  if (used_ < min_envs) return false;
+  const int n = std::min(used_, cfg_.num_envs);
+  takeEnvs(out, n, origin);
+  if (n < cfg_.num_envs) ++stats_.short_batches;
+  return true;
+}
+
+void BatchCollector::takeEnvs(ppo::RolloutBuffer& out, int B, BatchOrigin* origin) {
+  const int T = cfg_.horizon, od = cfg_.obs_dim, ad = cfg_.act_dim, C = capacity_;
+  MASA_CHECK(out.horizon() == T && out.obsDim() == od && out.actDim() == ad,
+             "rollout buffer is " << out.horizon() << " steps, obs " << out.obsDim() << ", act " << out.actDim()
+                                  << "; the collector's batches are " << T << " steps, obs " << od << ", act " << ad);
+  out.setNumEnvs(B);
   dropEventsOfFreeSlots();
   order_.clear();
   for (int s = 0; s < capacity_; ++s) {
@@ -231,7 +245,6 @@ bool BatchCollector::take(ppo::RolloutBuffer& out, BatchOrigin* origin) {
     release(order_[b]);
   }
   ++stats_.batches;
-  return true;
 }
 
 }  // namespace masa::learner

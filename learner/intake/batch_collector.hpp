@@ -34,6 +34,7 @@ struct CollectorStats {
   int64_t envs_stale = 0;     // dropped because their version fell behind current - lag
   int64_t envs_overflow = 0;  // dropped because the pool was full
   int64_t batches = 0;        // batches handed out
+  int64_t short_batches = 0;  // of them, short of environments that were lost (takeShort)
 };
 
 // Where each environment of a batch came from.
@@ -61,11 +62,15 @@ class BatchCollector {
   // batch columns, frees their slots and returns true; otherwise returns false and leaves `out`
   // alone. `origin`, when given, says where each column came from.
   bool take(ppo::RolloutBuffer& out, BatchOrigin* origin = nullptr);
+  // A batch short of environments that were lost: when at least min_envs (> 0) are buffered, takes
+  // them all (at most num_envs) as take() does, and sets `out` to that many environments.
+  bool takeShort(ppo::RolloutBuffer& out, int min_envs, BatchOrigin* origin = nullptr);
 
   const CollectorStats& stats() const { return stats_; }
   const CollectorConfig& config() const { return cfg_; }
 
  private:
+  void takeEnvs(ppo::RolloutBuffer& out, int num_envs, BatchOrigin* origin);
   int freeSlotFor(int64_t version);  // -1 when full of environments at least as new
   void release(int slot);
   // Forgets the truncations and episodes of released slots (before a slot is reused or read).

@@ -70,9 +70,7 @@ void PpoTrainer::resizeForBatch(const RolloutBuffer& buffer) {
              "rollout buffer is obs " << buffer.obsDim() << " / act " << buffer.actDim() << ", model obs "
                                       << model_->obsDim() << " / act " << model_->actDim());
   const int n = buffer.size();
-  MASA_CHECK(n % config_.minibatch_size == 0, "batch of " << buffer.numEnvs() << " envs x " << buffer.horizon()
-                                                          << " steps = " << n << " is not a multiple of minibatch_size "
-                                                          << config_.minibatch_size);
+  MASA_CHECK(n > 0, "empty rollout buffer");
   if (n == batch_size_ && truncation_values_.cols() == buffer.numEnvs()) return;
   batch_size_ = n;
   old_values_.resize(1, n);
@@ -160,8 +158,10 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
                                                                         << batch_size_);
   model::ActorCritic<float>& model = *model_;
   auto& params = model.params();
-  const int m = config_.minibatch_size;
-  const int minibatches_per_mini_epoch = batch_size_ / m;
+  // A full batch is a whole number of minibatches of minibatch_size (the config checks it). A batch
+  // short of lost environments splits into as many minibatches as it needs, of equal sizes at most
+  // minibatch_size, so that every sample is used once per mini-epoch and no step is a tiny one.
+  const int minibatches_per_mini_epoch = (batch_size_ + config_.minibatch_size - 1) / config_.minibatch_size;
   const float max_norm = static_cast<float>(config_.grad_norm);
   const auto obs = buffer.obs();
   const auto actions = buffer.actions();
@@ -180,7 +180,9 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
     for (int i = batch_size_ - 1; i > 0; --i) std::swap(order_[i], order_[static_cast<int>(rng() % (i + 1))]);
 
     for (int k = 0; k < minibatches_per_mini_epoch; ++k) {
-      const int* idx = order_.data() + static_cast<std::ptrdiff_t>(k) * m;
+      const int64_t begin = static_cast<int64_t>(k) * batch_size_ / minibatches_per_mini_epoch;
+      const int m = static_cast<int>(static_cast<int64_t>(k + 1) * batch_size_ / minibatches_per_mini_epoch - begin);
+      const int* idx = order_.data() + begin;
       for (int j = 0; j < m; ++j) {
         const int c = idx[j];
         mb_obs_.col(j) = obs.col(c);
@@ -193,10 +195,18 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
         mb_returns_(0, j) = returns_(0, c);
       }
 
-      model.forward(mb_obs_);
+      model.forward(mb_obs_.leftCols(m));
       model.logStd(log_std_);
-      const PpoLossBatch<float> batch{model.mean(), log_std_,   model.value(), mb_actions_,   mb_old_log_prob_,
-                                      mb_old_mean_, mb_old_log_std_, mb_adv_, mb_old_value_, mb_returns_};
+      const PpoLossBatch<float> batch{model.mean(),
+                                      log_std_,
+                                      model.value(),
+                                      mb_actions_.leftCols(m),
+                                      mb_old_log_prob_.leftCols(m),
+                                      mb_old_mean_.leftCols(m),
+                                      mb_old_log_std_.leftCols(m),
+                                      mb_adv_.leftCols(m),
+                                      mb_old_value_.leftCols(m),
+                                      mb_returns_.leftCols(m)};
       const PpoLossStats ls = loss_.compute(batch);
       for (int j = 0; j < m; ++j) {
         kl_ref_mean_.col(idx[j]) = model.mean().col(j);

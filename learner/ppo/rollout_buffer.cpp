@@ -14,6 +14,16 @@ RolloutBuffer::RolloutBuffer(int num_envs, int horizon, int obs_dim, int act_dim
   returns_ = StepMat<Scalar>::Zero(horizon, num_envs);
 }
 
+void RolloutBuffer::setNumEnvs(int num_envs) {
+  MASA_CHECK(num_envs > 0, "rollout buffer needs a positive number of environments, got " << num_envs);
+  data_.allocate(num_envs, horizon(), obsDim(), actDim(), data_.term_names);
+  if (values_.cols() != num_envs) {
+    values_.resize(horizon(), num_envs);
+    advantages_.resize(horizon(), num_envs);
+    returns_.resize(horizon(), num_envs);
+  }
+}
+
 void RolloutBuffer::addFinalObs(int t, int e, const ConstMatRef<Scalar>& obs_column) {
   MASA_CHECK(obs_column.rows() == obsDim() && obs_column.cols() == 1,
              "final obs is " << obs_column.rows() << "x" << obs_column.cols() << ", expected " << obsDim() << "x1");
@@ -34,7 +44,7 @@ void RolloutBuffer::checkFinalObs() const {
     previous = idx;
   }
   int truncations = 0;
-  for (uint8_t f : data_.truncated) truncations += f != 0;
+  for (int i = 0; i < size(); ++i) truncations += data_.truncated[i] != 0;
   MASA_CHECK(truncations == numFinalObs(),
              truncations << " truncated steps but " << numFinalObs() << " final observations: a truncated step has none");
 }

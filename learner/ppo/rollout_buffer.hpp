@@ -38,6 +38,10 @@ class RolloutBuffer {
 
   RolloutBuffer(int num_envs, int horizon, int obs_dim, int act_dim);
 
+  // A batch short of environments (some were lost on the way): the first num_envs columns of each
+  // step. Growing back to the constructed size reuses the memory.
+  void setNumEnvs(int num_envs);
+
   int numEnvs() const { return data_.num_envs; }
   int horizon() const { return data_.horizon; }
   int obsDim() const { return data_.obs_dim; }

@@ -108,6 +108,8 @@ EOF
     # Steady state: from the end of update 5 to the last (wall_time_s is column 4).
     upm=$(awk -F, -v n="$measure" 'NR == 6 { t0 = $4 } NR == n + 1 { t1 = $4 } END { printf "%.1f", (n - 5) * 60 / (t1 - t0) }' "$csv")
     drops=$(grep "^masa_learner: rollout chunks accepted" "$work/launcher.log" | tail -1 | sed 's/^masa_learner: //')
+    short=$(sed -n 's/^masa_learner: updates on batches short of lost environments \([0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
+    [ -n "$short" ] && drops="$drops, short batches $short"
     dropped=$(ip netns exec "$ns_l" nft list chain inet masa_test input | sed -n 's/.*counter packets \([0-9]*\).*/\1/p')
     echo "MEASURE: drop $drop% updates $measure datagrams_dropped ${dropped:-0} ($drops) updates_per_minute $upm"
     rm -rf "$work"

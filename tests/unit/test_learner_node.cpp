@@ -6,6 +6,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <thread>
 #include <random>
 #include <sstream>
 #include <string>
@@ -83,9 +85,12 @@ struct FakeActor {
   }
 
   // Publishes the rollout's chunks as actor 0's rollout `seq`, acted with `version`.
-  int send(transport::Transport& t, int64_t run_id, int64_t seq, int64_t version) {
+  // Chunks `keep` says no to are lost on the way.
+  int send(transport::Transport& t, int64_t run_id, int64_t seq, int64_t version,
+           const std::function<bool(int chunk_index)>& keep = {}) {
     const auto chunks = chunker.split(rollout, {run_id, 0, seq, version});
-    for (const auto& c : chunks) t.publish(transport::kRolloutChannel, c);
+    for (const auto& c : chunks)
+      if (!keep || keep(c.chunk_index)) t.publish(transport::kRolloutChannel, c);
     return static_cast<int>(chunks.size());
   }
 };
@@ -323,6 +328,62 @@ TEST(LearnerNode, ResumeCutsMetricsCsvBackToTheCheckpointsUpdate) {
   EXPECT_EQ(lines[7].rfind("6,7,", 0), 0u) << lines[7];
   fs::remove_all(dir);
   fs::remove_all(saved);
+}
+
+// A lost chunk costs its own environments only: once the loss is known (its rollout's last chunk
+// came, or nothing more of it within runner.loss_grace_s) the batch forms without them, instead of
+// waiting for the actor's next rollout (the learner used to stall until then: 0.79 of the lossless
+// update rate at 5% datagram loss on the namespace LAN).
+TEST(LearnerNode, ABatchFormsShortOfLostChunksOnceTheirLossIsKnown) {
+  auto rc = smallConfig();  // 8 environments x 4 steps, minibatches of 16
+  rc.runner.loss_grace_s = 0.5;
+  rc.runner.min_batch_fraction = 0.5;
+  const fs::path dir = freshDir("short");
+  Learner learner(rc, options(dir, 21));
+  FakeActor actor(rc, 7);
+  actor.chunker = actor::RolloutChunker(1);  // one environment per chunk
+  ASSERT_EQ(actor.send(learner.transport(), 21, 0, 0), 8);
+  ASSERT_TRUE(stepUntilUpdate(learner)) << "a full batch";
+  ASSERT_EQ(learner.envSteps(), 32);
+
+  // Chunk 5 lost, the last one (7) came: the loss is known at once.
+  actor.send(learner.transport(), 21, 1, 1, [](int c) { return c != 5; });
+  ASSERT_TRUE(stepUntilUpdate(learner)) << "the learner waits for a chunk that is lost";
+  EXPECT_EQ(learner.version(), 2);
+  EXPECT_EQ(learner.envSteps(), 32 + 7 * 4);
+  EXPECT_EQ(learner.shortBatches(), 1);
+
+  // The last chunk lost: known when the grace has passed, not before.
+  actor.send(learner.transport(), 21, 2, 2, [](int c) { return c != 7; });
+  EXPECT_FALSE(stepUntilUpdate(learner, 20)) << "within the grace the chunk may still come";
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  ASSERT_TRUE(stepUntilUpdate(learner));
+  EXPECT_EQ(learner.version(), 3);
+  EXPECT_EQ(learner.envSteps(), 32 + 7 * 4 + 7 * 4);
+
+  // Fewer than min_batch_fraction of the environments came: no batch, however long the wait.
+  actor.send(learner.transport(), 21, 3, 3, [](int c) { return c < 3; });
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  EXPECT_FALSE(stepUntilUpdate(learner, 20));
+  EXPECT_EQ(learner.version(), 3);
+  actor.send(learner.transport(), 21, 4, 3);  // the actor's next rollout fills it
+  ASSERT_TRUE(stepUntilUpdate(learner));
+  EXPECT_EQ(learner.version(), 4);
+  EXPECT_EQ(learner.shortBatches(), 2);
+  fs::remove_all(dir);
+}
+
+TEST(LearnerNode, AMinibatchSizeThatDoesNotDivideTheBatchIsRefusedByName) {
+  auto rc = smallConfig();
+  rc.ppo.minibatch_size = 12;  // 8 x 4 = 32 samples
+  const fs::path dir = freshDir("mb");
+  try {
+    Learner learner(rc, options(dir, 22));
+    ADD_FAILURE() << "a learner was made";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("ppo.minibatch_size 12 must divide the batch"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace

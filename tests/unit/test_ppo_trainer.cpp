@@ -209,18 +209,41 @@ TEST(PpoTrainerPrepare, ValuesAreInRealUnitsOfTheValueNormalizerBeforeItsUpdate)
   EXPECT_NE(s.model->valueNormalizer().mean()(0), before.mean()(0));  // then fed the returns
 }
 
-TEST(PpoTrainerPrepare, RejectsTimeOutWithoutFinalObsAndBatchNotSplittingIntoMinibatches) {
+TEST(PpoTrainerPrepare, RejectsTimeOutWithoutFinalObs) {
   Rig s(model::Method::kSa);
   Rng rng(3);
   fillOneStepBatch(s, rng);
   s.buffer->truncated()(0, 0) = 1;
   EXPECT_THROW(s.trainer->prepare(*s.buffer), std::invalid_argument);
+}
 
-  config::PpoConfig ppo = smallPpo();
-  ppo.minibatch_size = 48;  // 128 samples
-  Rig odd(model::Method::kSa, ppo);
-  fillOneStepBatch(odd, rng);
-  EXPECT_THROW(odd.trainer->prepare(*odd.buffer), std::invalid_argument);
+// A batch short of environments lost on the network (the learner's runner.min_batch_fraction):
+// 20 of 32 environments x 4 steps = 80 samples, minibatch_size 32. It trains in ceil(80 / 32) = 3
+// minibatches of 26-27 samples per mini-epoch (every sample once, none a tiny last step), learns
+// like a full batch, and the next full batch goes back to whole minibatches.
+TEST(PpoTrainerShortBatch, SplitsIntoEqualMinibatchesAndLearns) {
+  Rig s(model::Method::kMasa);
+  Rng rng(13);
+  s.buffer->setNumEnvs(20);
+  ASSERT_EQ(s.buffer->size(), 80);
+  fillOneStepBatch(s, rng);
+  const Mat<float> lp_before = logProbs(s);
+  const PpoStats st = s.trainer->update(*s.buffer, rng);
+  EXPECT_EQ(st.minibatches, 3 * 4);
+  EXPECT_TRUE(std::isfinite(st.total_loss) && std::isfinite(st.kl)) << st.total_loss << " " << st.kl;
+  const Mat<float> lp_after = logProbs(s);
+  double up = 0, down = 0;  // log-prob change of the actions the advantage favoured / disfavoured
+  for (int t = 0; t < s.buffer->horizon(); ++t)
+    for (int e = 0; e < s.buffer->numEnvs(); ++e) {
+      const int c = s.buffer->column(t, e);
+      (s.buffer->rewards()(t, e) > 0 ? up : down) += lp_after(0, c) - lp_before(0, c);
+    }
+  EXPECT_GT(up, 0.0);
+  EXPECT_LT(down, 0.0);
+
+  s.buffer->setNumEnvs(kEnvs);
+  fillOneStepBatch(s, rng);
+  EXPECT_EQ(s.trainer->update(*s.buffer, rng).minibatches, (kEnvs * kHorizon / 32) * 4);
 }
 
 bool bitwiseEqual(const Vec<float>& a, const Vec<float>& b) {

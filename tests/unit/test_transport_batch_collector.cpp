@@ -1,10 +1,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <vector>
 
 #include "learner/intake/batch_collector.hpp"
 #include "learner/intake/rollout_assembler.hpp"
+#include "learner/intake/round_tracker.hpp"
 #include "actors/rollout_chunker.hpp"
 #include "test_transport_support.hpp"
 
@@ -221,6 +223,87 @@ TEST(BatchCollector, ReusedSlotsCarryOnlyTheEventsOfTheirNewEnvironments) {
   ASSERT_TRUE(take(full, batch));
   EXPECT_EQ(eventsOf(batch.data()), newer);
   batch.buffer.checkFinalObs();
+}
+
+// A batch short of lost environments: at least min_envs buffered are taken whole (episodes and
+// truncations with them), the buffer shrinks to them, and the next full batch grows it back.
+TEST(BatchCollector, TakeShortTakesWhatArrivedOnceEnoughDid) {
+  Feeder feeder(0);
+  BatchCollector collector(collectorConfig(10, 0));
+  testing::TakenBatch batch(collector.config());
+  feeder.send(collector, 0, 0.3);  // 6 environments, with events
+  EXPECT_FALSE(collector.takeShort(batch.buffer, 7, &batch.origin)) << "fewer than min_envs";
+  EXPECT_EQ(collector.bufferedEnvs(), 6);
+  ASSERT_TRUE(collector.takeShort(batch.buffer, 5, &batch.origin));
+  EXPECT_EQ(batch.buffer.numEnvs(), 6);
+  EXPECT_EQ(batch.buffer.size(), 6 * kShape.horizon);
+  EXPECT_EQ(collector.bufferedEnvs(), 0);
+  EXPECT_EQ(collector.stats().short_batches, 1);
+  EXPECT_EQ(eventsOf(batch.data()), eventsOf(feeder.lastRollout())) << "the rollout's events, in its own columns";
+  batch.buffer.checkFinalObs();
+  for (int b = 0; b < 6; ++b) EXPECT_EQ(batch.origin.env_index[b], b);
+
+  feeder.send(collector, 0);
+  feeder.send(collector, 0);
+  ASSERT_TRUE(collector.takeShort(batch.buffer, 5, &batch.origin)) << "a full batch is never short";
+  EXPECT_EQ(batch.buffer.numEnvs(), 10);
+  EXPECT_EQ(collector.stats().short_batches, 1);
+  EXPECT_EQ(collector.bufferedEnvs(), 2);
+}
+
+using TrackerClock = RoundTracker::Clock;
+constexpr auto kMs = std::chrono::milliseconds(1);
+
+// Two actors with 4 chunks per rollout; the learner has just updated once.
+RoundTracker trackerAfterAFullRound(TrackerClock::time_point t0) {
+  RoundTracker r(0.010);
+  for (int actor = 0; actor < 2; ++actor)
+    for (int c = 0; c < 4; ++c) r.chunkArrived(actor, 0, c, 4, t0);
+  r.newRound();
+  return r;
+}
+
+TEST(RoundTracker, TheFirstRoundNeverSettlesNobodyIsKnownYet) {
+  const auto t0 = TrackerClock::now();
+  RoundTracker r(0.010);
+  for (int c = 0; c < 3; ++c) r.chunkArrived(0, 0, c, 4, t0);
+  EXPECT_FALSE(r.settled(t0 + 1000 * kMs));
+}
+
+TEST(RoundTracker, ALostChunkIsKnownWhenItsRolloutsLastChunkComes) {
+  const auto t0 = TrackerClock::now();
+  RoundTracker r = trackerAfterAFullRound(t0);
+  for (int c : {0, 1, 3}) r.chunkArrived(0, 1, c, 4, t0 + 5 * kMs);  // chunk 2 lost
+  EXPECT_FALSE(r.settled(t0 + 5 * kMs)) << "actor 1 has not delivered yet";
+  EXPECT_FALSE(r.settled(t0 + 500 * kMs)) << "however long: a slow actor's rollout is worth waiting for";
+  for (int c = 0; c < 4; ++c) r.chunkArrived(1, 1, c, 4, t0 + 6 * kMs);
+  EXPECT_TRUE(r.settled(t0 + 6 * kMs));
+  EXPECT_EQ(r.nextDeadline(), TrackerClock::time_point::max());
+}
+
+TEST(RoundTracker, ALostLastChunkIsKnownAfterTheGrace) {
+  const auto t0 = TrackerClock::now();
+  RoundTracker r = trackerAfterAFullRound(t0);
+  for (int c = 0; c < 4; ++c) r.chunkArrived(1, 1, c, 4, t0 + 5 * kMs);
+  for (int c : {0, 1, 2}) r.chunkArrived(0, 1, c, 4, t0 + 7 * kMs);  // chunk 3 lost
+  EXPECT_EQ(r.nextDeadline(), t0 + 17 * kMs);
+  EXPECT_FALSE(r.settled(t0 + 16 * kMs));
+  EXPECT_TRUE(r.settled(t0 + 17 * kMs));
+  r.chunkArrived(0, 1, 3, 4, t0 + 12 * kMs);  // it came after all, within the grace
+  EXPECT_TRUE(r.settled(t0 + 12 * kMs));
+}
+
+TEST(RoundTracker, AnActorSilentForAWholeRoundIsNoLongerWaitedFor) {
+  const auto t0 = TrackerClock::now();
+  RoundTracker r = trackerAfterAFullRound(t0);
+  for (int c = 0; c < 4; ++c) r.chunkArrived(0, 1, c, 4, t0 + 5 * kMs);
+  EXPECT_FALSE(r.settled(t0 + 5 * kMs)) << "actor 1 delivered last round";
+  r.newRound();  // the batch formed anyway (actor 0's next rollout filled it)
+  for (int c = 0; c < 3; ++c) r.chunkArrived(0, 2, c, 4, t0 + 9 * kMs);
+  EXPECT_TRUE(r.settled(t0 + 20 * kMs)) << "actor 1 is dead or far behind; actor 0's last chunk was lost";
+  // A newer rollout of an actor replaces its older one in the round.
+  r.chunkArrived(0, 3, 0, 4, t0 + 21 * kMs);
+  EXPECT_FALSE(r.settled(t0 + 21 * kMs));
 }
 
 }  // namespace
