@@ -173,8 +173,8 @@ bool Learner::step(int timeout_ms) {
   if (collector_ && collector_->take(*buffer_)) {
     update();
     updated = true;
-  } else if (collector_ && collector_->bufferedEnvs() >= min_batch_envs_ &&
-             round_.settled(std::chrono::steady_clock::now()) && collector_->takeShort(*buffer_, min_batch_envs_)) {
+  } else if (collector_ && round_.settled(std::chrono::steady_clock::now()) &&
+             collector_->takeShort(*buffer_, min_batch_envs_)) {
     update();  // the missing environments were lost: waiting would not bring them
     updated = true;
   }

@@ -158,7 +158,7 @@ PpoStats PpoTrainer::optimize(const RolloutBuffer& buffer, Rng& rng) {
                                                                         << batch_size_);
   model::ActorCritic<float>& model = *model_;
   auto& params = model.params();
-  // A full batch is a whole number of minibatches of minibatch_size (the config checks it). A batch
+  // A full batch is a whole number of minibatches of minibatch_size (the learner checks it). A batch
   // short of lost environments splits into as many minibatches as it needs, of equal sizes at most
   // minibatch_size, so that every sample is used once per mini-epoch and no step is a tiny one.
   const int minibatches_per_mini_epoch = (batch_size_ + config_.minibatch_size - 1) / config_.minibatch_size;

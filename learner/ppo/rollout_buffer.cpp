@@ -44,7 +44,7 @@ void RolloutBuffer::checkFinalObs() const {
     previous = idx;
   }
   int truncations = 0;
-  for (int i = 0; i < size(); ++i) truncations += data_.truncated[i] != 0;
+  for (uint8_t f : data_.truncated) truncations += f != 0;
   MASA_CHECK(truncations == numFinalObs(),
              truncations << " truncated steps but " << numFinalObs() << " final observations: a truncated step has none");
 }

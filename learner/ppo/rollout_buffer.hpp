@@ -39,7 +39,8 @@ class RolloutBuffer {
   RolloutBuffer(int num_envs, int horizon, int obs_dim, int act_dim);
 
   // A batch short of environments (some were lost on the way): the first num_envs columns of each
-  // step. Growing back to the constructed size reuses the memory.
+  // step. The samples keep their memory (growing back to the constructed size allocates nothing);
+  // values, advantages and returns are resized.
   void setNumEnvs(int num_envs);
 
   int numEnvs() const { return data_.num_envs; }
