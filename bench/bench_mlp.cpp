@@ -83,7 +83,14 @@ void BM_Infer(benchmark::State& state) {
   mlp.infer(x);
   for (auto _ : state) benchmark::DoNotOptimize(mlp.infer(x).data());
   report(state, B, forwardFlopsPerSample(shape));
+  // Inference runs on one thread at these sizes: of_peak is the share of one core's FMA peak, and
+  // its inverse how far the time is from the FLOP bound.
+  const double gflops = forwardFlopsPerSample(shape) * B * static_cast<double>(state.iterations()) * 1e-9;
+  state.counters["of_peak"] =
+      benchmark::Counter(gflops / masa::bench::measuredPeakGflops(1), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_Infer)->Arg(1)->Arg(16)->Unit(benchmark::kMicrosecond)->UseRealTime();
+// 1: one agent (SA) in the robot runner; 2 and 4: a robot's agents (MASA: N columns a step); 16: a
+// small batch of environments.
+BENCHMARK(BM_Infer)->Arg(1)->Arg(2)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 }  // namespace

@@ -124,19 +124,24 @@ inline void panelTimesColumns(const float* __restrict a, Index lda, int depth, c
                               __mmask16 mask, __m512 (&acc)[MV][NR]) {
 #pragma GCC unroll 8
   for (int j = 0; j < NR; ++j)
-#pragma GCC unroll 3
+#pragma GCC unroll 32
     for (int i = 0; i < MV; ++i) acc[i][j] = _mm512_setzero_ps();
   const float* col[NR];
 #pragma GCC unroll 8
   for (int j = 0; j < NR; ++j) col[j] = b + j * ldb;
   for (int k = 0; k < depth; ++k, a += lda) {
     __m512 av[MV];
-#pragma GCC unroll 3
-    for (int i = 0; i < MV; ++i) av[i] = loadRow(a + i * kLanes, kMasked && i == MV - 1, mask);
+#pragma GCC unroll 32
+    for (int i = 0; i < MV; ++i) {
+      av[i] = loadRow(a + i * kLanes, kMasked && i == MV - 1, mask);
+      // Wide narrow-column tiles: keep the loaded row in a register. Left alone, GCC folds the
+      // load into each of the NR FMAs, NR loads per vector of W, and the loop becomes load-bound.
+      if constexpr (MV > 3 && NR > 1) __asm__("" : "+v"(av[i]));
+    }
 #pragma GCC unroll 8
     for (int j = 0; j < NR; ++j) {
       const __m512 bj = _mm512_set1_ps(col[j][k]);
-#pragma GCC unroll 3
+#pragma GCC unroll 32
       for (int i = 0; i < MV; ++i) acc[i][j] = _mm512_fmadd_ps(av[i], bj, acc[i][j]);
     }
   }
@@ -147,15 +152,36 @@ void forwardTile(const float* a, Index lda, int depth, const float* bias, const 
                  Index ldy, __mmask16 mask) {
   __m512 acc[MV][NR];
   panelTimesColumns<MV, NR, kMasked>(a, lda, depth, x, ldx, mask, acc);
-  __m512 b[MV];
-#pragma GCC unroll 3
-  for (int i = 0; i < MV; ++i)
-    b[i] = bias ? loadRow(bias + i * kLanes, kMasked && i == MV - 1, mask) : _mm512_setzero_ps();
+  if constexpr (MV > 3) {
+    // Narrow-column tiles of up to 28 vectors: store z = acc + bias, then activate it in a loop
+    // (in L1; one instance of the activation's code instead of MV x NR inlined copies).
 #pragma GCC unroll 8
-  for (int j = 0; j < NR; ++j)
+    for (int j = 0; j < NR; ++j)
+#pragma GCC unroll 32
+      for (int i = 0; i < MV; ++i) {
+        const bool masked = kMasked && i == MV - 1;
+        const __m512 b = bias ? loadRow(bias + i * kLanes, masked, mask) : _mm512_setzero_ps();
+        storeRow(y + j * ldy + i * kLanes, _mm512_add_ps(acc[i][j], b), masked, mask);
+      }
+    if constexpr (A != Activation::kIdentity)
+      for (int j = 0; j < NR; ++j)
+        for (int i = 0; i < MV; ++i) {
+          float* p = y + j * ldy + i * kLanes;
+          const bool masked = kMasked && i == MV - 1;
+          storeRow(p, activation<A>(loadRow(p, masked, mask)), masked, mask);
+        }
+  } else {
+    __m512 b[MV];
 #pragma GCC unroll 3
     for (int i = 0; i < MV; ++i)
-      storeRow(y + j * ldy + i * kLanes, activation<A>(_mm512_add_ps(acc[i][j], b[i])), kMasked && i == MV - 1, mask);
+      b[i] = bias ? loadRow(bias + i * kLanes, kMasked && i == MV - 1, mask) : _mm512_setzero_ps();
+#pragma GCC unroll 8
+    for (int j = 0; j < NR; ++j)
+#pragma GCC unroll 3
+      for (int i = 0; i < MV; ++i)
+        storeRow(y + j * ldy + i * kLanes, activation<A>(_mm512_add_ps(acc[i][j], b[i])), kMasked && i == MV - 1,
+                 mask);
+  }
 }
 
 template <Activation A, int MV, int NR, bool kMasked>
@@ -252,14 +278,72 @@ inline void forPanels(int rows, F&& f) {
   });
 }
 
+// Forward over few columns (single-sample inference, the robot runner's N agents, a batch's last
+// columns): a 3-vector panel would keep only 3 x NR FMA chains in flight, too few to hide the FMA
+// latency on two ports, and would stream W from L2 once per 48 rows. A narrow tile covers up to
+// kNarrowVectors<NR> vectors of rows (all 400 rows of a humanoid layer in one block when NR = 1)
+// in at most 28 + NR zmm registers, so W is read once, as one contiguous run per column.
+// Each result element is still summed over k in order from zero, exactly as in the 48 x 8 tile:
+// which tile computes a column changes no bit of it.
+template <int NR>
+inline constexpr int kNarrowVectors = NR == 1 ? 28 : NR == 2 ? 14 : NR == 3 ? 9 : 6;
+
+template <int kMax, int M = 1, class C>
+inline void dispatchVectors(int mv, C&& call) {
+  if constexpr (M < kMax) {
+    if (mv != M) return dispatchVectors<kMax, M + 1>(mv, call);
+  }
+  call(Int<M>{});
+}
+
+// Calls f(Int<MV>, masked, first row, mask) over blocks of at most kMax vectors of rows, sized
+// evenly (25 vectors with kMax = 9: 9, 8, 8).
+template <int kMax, class F>
+inline void forNarrowBlocks(int rows, F&& f) {
+  const int vectors = (rows + kLanes - 1) / kLanes;
+  const __mmask16 last = firstLanes(rows - (vectors - 1) * kLanes);
+  const int blocks = (vectors + kMax - 1) / kMax;
+  const int base = vectors / blocks, extra = vectors % blocks;
+  int row0 = 0;
+  for (int b = 0; b < blocks; ++b) {
+    const int mv = base + (b < extra ? 1 : 0);
+    const bool masked = b == blocks - 1 && rows % kLanes != 0;
+    const __mmask16 mask = masked ? last : __mmask16(0xFFFF);
+    dispatchVectors<kMax>(mv, [&](auto m) {
+      if (masked) f(m, std::true_type{}, row0, mask);
+      else f(m, std::false_type{}, row0, mask);
+    });
+    row0 += mv * kLanes;
+  }
+}
+
+// Calls f(Int<NR>, first column) over n columns: tiles of 8, then one of 4 and one of 1-3.
+template <class F>
+inline void forForwardColumnTiles(int n, F&& f) {
+  int j = 0;
+  for (; j + kTileCols <= n; j += kTileCols) f(Int<kTileCols>{}, j);
+  if (n - j >= 4) f(Int<4>{}, j), j += 4;
+  switch (n - j) {
+    case 3: f(Int<3>{}, j); break;
+    case 2: f(Int<2>{}, j); break;
+    case 1: f(Int<1>{}, j); break;
+    default: break;
+  }
+}
+
 template <Activation A>
 void forwardAct(const float* w, Index ldw, int rows, int depth, const float* bias, const float* x, Index ldx, float* y,
                 Index ldy, int n) {
-  forColumnTiles(n, [&](auto nr, int j) {
-    forPanels(rows, [&](auto mv, auto masked, int row0, __mmask16 mask) {
-      forwardTile<A, decltype(mv)::value, decltype(nr)::value, decltype(masked)::value>(
+  forForwardColumnTiles(n, [&](auto nr, int j) {
+    constexpr int NR = decltype(nr)::value;
+    auto tile = [&](auto mv, auto masked, int row0, __mmask16 mask) {
+      forwardTile<A, decltype(mv)::value, NR, decltype(masked)::value>(
           w + row0, ldw, depth, bias ? bias + row0 : nullptr, x + j * ldx, ldx, y + j * ldy + row0, ldy, mask);
-    });
+    };
+    if constexpr (NR <= 4)
+      forNarrowBlocks<kNarrowVectors<NR>>(rows, tile);
+    else
+      forPanels(rows, tile);
   });
 }
 

@@ -115,7 +115,34 @@ TEST_P(DenseKernels, WeightGradAccumulatesProductAndRowSums) {
 INSTANTIATE_TEST_SUITE_P(Shapes, DenseKernels,
                          ::testing::Values(Shape{1, 1, 1}, Shape{5, 3, 2}, Shape{16, 7, 8}, Shape{21, 100, 15},
                                            Shape{33, 4, 9}, Shape{48, 16, 17}, Shape{64, 5, 3}, Shape{100, 200, 31},
-                                           Shape{200, 74, 129}, Shape{400, 21, 7}, Shape{74, 400, 300}));
+                                           Shape{200, 74, 129}, Shape{400, 21, 7}, Shape{74, 400, 300},
+                                           // narrow forward tiles: 25 vectors in one block (n = 1),
+                                           // 29 vectors in three masked blocks (n = 2), 8 + 4 + 1
+                                           Shape{400, 30, 1}, Shape{450, 9, 2}, Shape{300, 11, 13}));
+
+// Which tile computes a column must not change a bit of it: the robot runner infers one sample (or
+// its N agents) and has to act exactly as the policy did in a batch during evaluation.
+TEST(DenseKernelsForward, AColumnIsBitIdenticalWhateverTileComputesIt) {
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  for (const int rows : {21, 100, 400, 450}) {
+    const int depth = 37, n = 19;  // 8 + 8 + 3 columns in one call
+    const Mat<float> w = Mat<float>::Random(rows, depth);
+    const Mat<float> bias = Mat<float>::Random(rows, 1);
+    const Mat<float> x = Mat<float>::Random(depth, n);
+    for (const Activation a : {Activation::kIdentity, Activation::kElu, Activation::kTanh, Activation::kRelu}) {
+      Mat<float> batch(rows, n);
+      dense::forward(w.data(), rows, rows, depth, bias.data(), a, x.data(), depth, batch.data(), rows, n);
+      for (int width = 1; width <= 4; ++width)
+        for (int j0 = 0; j0 + width <= n; j0 += width) {
+          Mat<float> part(rows, width);
+          dense::forward(w.data(), rows, rows, depth, bias.data(), a, x.data() + j0 * depth, depth, part.data(), rows,
+                         width);
+          EXPECT_TRUE(part == batch.middleCols(j0, width))
+              << "rows " << rows << ", columns " << j0 << ".." << j0 + width - 1 << " alone, " << activationName(a);
+        }
+    }
+  }
+}
 
 TEST(DenseKernelsPack, PanelsHoldRowsOfOpWZeroPadded) {
   if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
