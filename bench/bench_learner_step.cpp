@@ -98,7 +98,17 @@ void BM_LearnerStep(benchmark::State& state, bool with_critic) {
   omp_set_num_threads(threads);  // before the networks size their per-thread buffers
   {
     Learner learner(batch, with_critic);
+    // MASA_BENCH_CHUNK forces the fused engine's chunk width; otherwise the warm-up runs until
+    // both networks have measured theirs (chunk_tuner.hpp), so the timing sees the chosen width.
+    if (const char* chunk = std::getenv("MASA_BENCH_CHUNK")) {
+      learner.policy->forceChunkWidth(std::atoi(chunk));
+      if (learner.critic) learner.critic->forceChunkWidth(std::atoi(chunk));
+    }
     learner.step();  // first touch of every buffer stays out of the timing
+    for (int warm_up = 0; warm_up < 20 && !(learner.policy->chunkTuner().settled() &&
+                                            (!learner.critic || learner.critic->chunkTuner().settled()));
+         ++warm_up)
+      learner.step();
     double seconds = 0;
     for (auto _ : state) {
       const auto start = std::chrono::steady_clock::now();
@@ -115,6 +125,7 @@ void BM_LearnerStep(benchmark::State& state, bool with_critic) {
     state.SetItemsProcessed(state.iterations() * batch);
     state.counters["GFLOPs"] = gflops;
     state.counters["of_peak"] = gflops / peakGflops(threads);
+    state.SetLabel("chunk " + learner.policy->chunkTuner().summary());
   }
   omp_set_num_threads(saved_threads);
 }

@@ -11,7 +11,11 @@
 #include <chrono>
 #include <cstdlib>
 
+#include "../machine_peak.hpp"
+
 namespace {
+
+const bool kMachineDescribed = masa::bench::describeMachine();
 
 constexpr int kObs = 74, kAct = 21;
 
@@ -62,7 +66,8 @@ void BM_LibTorchLearnerStep(benchmark::State& state, bool with_critic) {
   }
   const double flops = flopsPerSample(kAct) + (with_critic ? flopsPerSample(1) : 0.0);
   const double gflops = flops * batch * static_cast<double>(state.iterations()) * 1e-9 / seconds;
-  const double peak = torch::get_num_threads() >= 2 ? 408.0 : 223.0;  // ../shared/PERFORMANCE.md
+  // This machine's measured peak for LibTorch's thread count, as bench_learner_step quotes it.
+  const double peak = masa::bench::measuredPeakGflops(std::min(torch::get_num_threads(), 2));
   state.SetItemsProcessed(state.iterations() * batch);
   state.counters["GFLOPs"] = gflops;
   state.counters["of_peak"] = gflops / peak;

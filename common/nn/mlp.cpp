@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <utility>
 
@@ -14,9 +15,10 @@ namespace masa::nn {
 namespace {
 using Eigen::Index;
 
-// Columns a thread takes through all layers at a time in the fused engine, so that a chunk's
-// activations (about 800 floats a column for the humanoid policy) stay in L2 between layers.
-constexpr int kChunk = 128;
+// The fused engine's unit of work: a thread takes whole blocks of columns through all layers
+// (ChunkTuner chooses how many at a time), and the threads split a backward by blocks.
+constexpr int kBlock = ChunkTuner::kBlock;
+constexpr int kWidestChunk = ChunkTuner::kCandidates.back();
 // Below these many columns per thread a second thread costs more than it saves (waking it takes
 // microseconds; backward also zeroes and sums a gradient partial of the whole network).
 constexpr int kMinForwardColumnsPerThread = 64;
@@ -109,7 +111,7 @@ void Mlp<S>::reserve(int batch) {
   if constexpr (kFused) {
     const int threads = std::max(1, omp_get_max_threads());
     scratch_.resize(threads);
-    for (Mat<S>& s : scratch_) s.setZero(max_padded, 2 * std::min(batch, kChunk));
+    for (Mat<S>& s : scratch_) s.setZero(max_padded, 2 * std::min(batch, kWidestChunk));
     grad_partial_.resize(threads - 1);
     for (Vec<S>& g : grad_partial_) g.setZero(numParams());
   } else {
@@ -134,13 +136,21 @@ int Mlp<S>::threadsFor(int B, int min_columns_per_thread) const {
 }
 
 template <typename S>
+int Mlp<S>::backwardColumnsPerThread(int B) const {
+  const int threads = std::min(threadsFor(B, kMinBackwardColumnsPerThread), static_cast<int>(scratch_.size()));
+  return (B + std::max(threads, 1) - 1) / std::max(threads, 1);
+}
+
+template <typename S>
 Eigen::Block<Mat<S>> Mlp<S>::forward(const ConstMatRef<S>& x) {
   MASA_CHECK(params_->finalized(), "MLP forward before the parameter set is finalized");
   MASA_CHECK(x.rows() == shape_.input, "MLP forward: input has " << x.rows() << " rows, expected " << shape_.input);
   const int B = static_cast<int>(x.cols());
   reserve(B);
   if constexpr (kFused) {
+    const auto start = std::chrono::steady_clock::now();
     forwardFused(x.data(), x.outerStride(), B, true);
+    forward_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   } else {
     input_.leftCols(B) = x;
     forwardGeneric(input_.data(), input_.rows(), B);
@@ -174,9 +184,12 @@ void Mlp<S>::backward(const ConstMatRef<S>& dy, MatRef<S>* dx) {
     MASA_CHECK(dx->rows() == shape_.input && dx->cols() == B,
                "MLP backward: dx is " << dx->rows() << "x" << dx->cols() << ", expected " << shape_.input << "x" << B);
   if (B == 0) return;
-  if constexpr (kFused)
+  if constexpr (kFused) {
+    const auto start = std::chrono::steady_clock::now();
     backwardFused(dy, dx);
-  else
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    chunk_tuner_.record(B, backwardColumnsPerThread(B), forward_seconds_ + seconds);
+  } else
     backwardGeneric(dy, dx);
 }
 
@@ -252,8 +265,9 @@ void Mlp<S>::forwardFused(const S* x, Index ldx, int B, bool keep_input) {
   if constexpr (kFused) {
     const S* values = params_->values().data();
     const int L = numLayers();
+    const int width = chunk_tuner_.width(backwardColumnsPerThread(B));
     auto chunk = [&](int j0) {
-      const int n = std::min(kChunk, B - j0);
+      const int n = std::min(width, B - j0);
       const S* in = x + j0 * ldx;
       Index ld_in = ldx;
       if (keep_input) {
@@ -271,14 +285,14 @@ void Mlp<S>::forwardFused(const S* x, Index ldx, int B, bool keep_input) {
         ld_in = ld_out;
       }
     };
-    const int chunks = (B + kChunk - 1) / kChunk;
+    const int chunks = (B + width - 1) / width;
     const int threads = std::min(chunks, threadsFor(B, kMinForwardColumnsPerThread));
     if (threads <= 1) {
-      for (int c = 0; c < chunks; ++c) chunk(c * kChunk);
+      for (int c = 0; c < chunks; ++c) chunk(c * width);
       return;
     }
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-    for (int c = 0; c < chunks; ++c) chunk(c * kChunk);
+    for (int c = 0; c < chunks; ++c) chunk(c * width);
   }
 }
 
@@ -292,9 +306,8 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
       const Layer& l = layers_[k];
       dense::pack(values + l.w_offset, l.out, true, l.in, l.out, packed_t_.data() + packed_t_offset_[k]);
     }
-    // One chunk of columns through every layer, on thread t's scratch, into gradient `grad`.
-    auto chunk = [&](int j0, int t, S* grad) {
-      const int n = std::min(kChunk, B - j0);
+    // Columns [j0, j0 + n) through every layer, on thread t's scratch, into gradient `grad`.
+    auto chunk = [&](int j0, int n, int t, S* grad) {
       Mat<S>& scratch = scratch_[t];
       const Index ld_s = scratch.rows();
       S* buffers[2] = {scratch.data(), scratch.data() + ld_s * (scratch.cols() / 2)};
@@ -332,11 +345,21 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
         }
       }
     };
+    // Blocks [b0, b1) in chunks of `width` columns. Whatever the width, each layer's weight
+    // gradient receives the same block sums in the same order (dense::weightGrad sums a chunk
+    // block by block), so the width changes no bit of the result.
+    const int width = chunk_tuner_.width(backwardColumnsPerThread(B));
+    auto blocks_in_chunks = [&](int b0, int b1, int t, S* grad) {
+      for (int b = b0; b < b1; b += width / kBlock) {
+        const int j0 = b * kBlock;
+        chunk(j0, std::min({width, (b1 - b) * kBlock, B - j0}), t, grad);
+      }
+    };
     S* grads = params_->grads().data() + param_begin_;
-    const int chunks = (B + kChunk - 1) / kChunk;
-    const int threads = std::min({chunks, threadsFor(B, kMinBackwardColumnsPerThread), static_cast<int>(scratch_.size())});
+    const int blocks = (B + kBlock - 1) / kBlock;
+    const int threads = std::min({blocks, threadsFor(B, kMinBackwardColumnsPerThread), static_cast<int>(scratch_.size())});
     if (threads <= 1) {
-      for (int c = 0; c < chunks; ++c) chunk(c * kChunk, 0, grads);
+      blocks_in_chunks(0, blocks, 0, grads);
       return;
     }
     const int P = numParams();
@@ -346,11 +369,15 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
       const int t = omp_get_thread_num(), nt = omp_get_num_threads();
       S* grad = t == 0 ? grads : grad_partial_[t - 1].data();
       if (t > 0) grad_partial_[t - 1].setZero();
-      // Static: which chunks a thread sums must not depend on timing, or the float sums (and so
-      // the whole run) would differ between runs of the same seed.
-#pragma omp for schedule(static)
-      for (int c = 0; c < chunks; ++c) chunk(c * kChunk, t, grad);
-      // (the loop's implicit barrier: every partial is complete)
+      // Static: which blocks a thread sums must not depend on timing, or the float sums (and so
+      // the whole run) would differ between runs of the same seed. Contiguous runs of blocks,
+      // the first (blocks % nt) threads one more (OpenMP's static schedule, as before chunks
+      // could be wider than a block).
+      const int per = blocks / nt, extra = blocks % nt;
+      const int b0 = t * per + std::min(t, extra);
+      blocks_in_chunks(b0, b0 + per + (t < extra ? 1 : 0), t, grad);
+#pragma omp barrier
+      // (every partial is complete)
       const auto [p0, p1] = columnRange(P, t, nt);
       Eigen::Map<Vec<S>> total(grads + p0, p1 - p0);
       for (int u = 1; u < nt; ++u) total += grad_partial_[u - 1].segment(p0, p1 - p0);

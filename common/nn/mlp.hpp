@@ -5,10 +5,11 @@
 // loop allocates nothing after its first step.
 //
 // Two engines behind one interface. In float on AVX-512 machines (dense::kAvailable) the layers
-// run on the fused kernels of dense_kernels.hpp, and the batch is cut into chunks of 128 columns
-// that the OpenMP threads take in turn: a chunk goes through every layer while its activations
-// stay in L2, and each thread adds its weight gradients to its own partial, summed once at the
-// end (no synchronization between layers). Otherwise (double, or no AVX-512) every product is one
+// run on the fused kernels of dense_kernels.hpp, and the batch is cut into chunks that the OpenMP
+// threads take in turn: a chunk goes through every layer while its activations stay in L2, and
+// each thread adds its weight gradients to its own partial, summed once at the end (no
+// synchronization between layers). The chunk width is measured on the machine during the first
+// training steps (chunk_tuner.hpp); no result depends on it. Otherwise (double, or no AVX-512) every product is one
 // GemmWorkspace call and the elementwise work separate passes. Only post-activations are stored
 // (f' is computed from them); hidden ones have their rows padded to a multiple of 16 so that
 // every column starts 64-byte aligned.
@@ -20,6 +21,7 @@
 
 #include "common/core/types.hpp"
 #include "common/nn/activation.hpp"
+#include "common/nn/chunk_tuner.hpp"
 #include "common/nn/dense_kernels.hpp"
 #include "common/nn/gemm.hpp"
 #include "common/nn/parameter_set.hpp"
@@ -60,6 +62,11 @@ class Mlp {
   // Backward of the last forward: grads += dL/dparams; if dx is given, dx = dL/dx (input x B).
   void backward(const ConstMatRef<S>& dy, MatRef<S>* dx = nullptr);
 
+  // The fused engine's chunk width: measured during the first training steps, or forced (a
+  // multiple of ChunkTuner::kBlock). Every width gives bit-identical results.
+  const ChunkTuner& chunkTuner() const { return chunk_tuner_; }
+  void forceChunkWidth(int columns) { chunk_tuner_.force(columns); }
+
  private:
   struct Layer {
     int in, out, w_offset, b_offset;
@@ -73,6 +80,8 @@ class Mlp {
   void backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx);
   // Threads for a batch of B columns (1 inside a parallel region or for small batches).
   int threadsFor(int B, int min_columns_per_thread) const;
+  // Columns per thread of a backward over B columns (what the chunk tuner sizes against).
+  int backwardColumnsPerThread(int B) const;
 
   ParameterSet<S>* params_;
   MlpShape shape_;
@@ -96,6 +105,8 @@ class Mlp {
   std::vector<Mat<S>> scratch_;
   std::vector<Vec<S>> grad_partial_;
   int param_begin_ = 0;
+  ChunkTuner chunk_tuner_;
+  double forward_seconds_ = 0;  // of the last training forward, for the tuner
 };
 
 }  // namespace masa::nn
