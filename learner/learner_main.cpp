@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
     }
     std::cout << std::endl;
     std::cout << "masa_learner: updates on batches short of lost environments " << learner.shortBatches() << std::endl;
+    std::cout << "masa_learner: MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
     std::cout << "masa_learner: other messages rejected before decoding: " << learner.transport().rejectSummary()
               << std::endl;
   } catch (const std::exception& e) {

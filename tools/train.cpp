@@ -97,6 +97,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "masa_train: %lld updates, %lld env steps; run dir %s\n",
                  static_cast<long long>(learner.updates()), static_cast<long long>(learner.envSteps()),
                  learner.runDir().c_str());
+    std::fprintf(stderr, "masa_train: MLP chunk width: %s\n", learner.model().chunkWidthSummary().c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_train: %s\n", e.what());
     return 2;

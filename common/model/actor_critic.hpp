@@ -9,6 +9,7 @@
 
 #include <iosfwd>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "common/model/agent_maps.hpp"
@@ -79,6 +80,13 @@ class ActorCritic {
   // V(o) only (1 x B, normalized value units): no policy work. Like actMean, it overwrites the
   // caches of forward(), so backward() must follow a fresh forward() (checked).
   Eigen::Map<const Mat<S>> criticValue(const ConstMatRef<S>& raw_obs);
+
+  // The fused engine's chunk width of the policy and the critic networks, and what decided it
+  // (nn/chunk_tuner.hpp): printed by the learner, so a run records what its CPU chose.
+  std::string chunkWidthSummary() const {
+    return "policy " + policy_.net().chunkTuner().summary() + "; critic " +
+           critic_.featureNet().chunkTuner().summary();
+  }
 
   // Parameters and normalizer statistics, for checkpoints.
   void save(std::ostream& os) const;

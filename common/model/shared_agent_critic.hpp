@@ -23,6 +23,9 @@ class SharedAgentCritic {
   // Gradient of the last forward's values (1 x numPooled*B). dobs optional as in the policy.
   void backward(const ConstMatRef<S>& dvalues, MatRef<S>* dobs = nullptr);
 
+  // Psi, the per-agent feature network (the critic's bulk; Theta is a small head).
+  const nn::Mlp<S>& featureNet() const { return psi_; }
+
  private:
   const AgentMaps* maps_;
   AgentStack<S> stack_;

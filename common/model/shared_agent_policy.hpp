@@ -28,6 +28,7 @@ class SharedAgentPolicy {
 
   const AgentMaps& maps() const { return *maps_; }
   nn::Mlp<S>& net() { return phi_; }
+  const nn::Mlp<S>& net() const { return phi_; }
 
  private:
   const AgentMaps* maps_;
