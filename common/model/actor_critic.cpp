@@ -103,7 +103,7 @@ Eigen::Map<const Mat<S>> ActorCritic<S>::actMean(const ConstMatRef<S>& raw_obs) 
   normalizeInput(raw_obs);
   backward_ready_ = false;
   mean_ptr_ = value_ptr_ = nullptr;
-  const S* p = policy_.forward(obs_normalized_.leftCols(batch_)).data();
+  const S* p = policy_.infer(obs_normalized_.leftCols(batch_)).data();
   return Eigen::Map<const Mat<S>>(p, actDim(), batch_);
 }
 

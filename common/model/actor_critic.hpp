@@ -47,8 +47,9 @@ class ActorCritic {
 
   const ModelConfig& config() const { return config_; }
   const sym::SymmetrySpec& spec() const { return spec_; }
-  int obsDim() const { return spec_.obsDim(); }
-  int actDim() const { return spec_.actDim(); }
+  // (From the agent maps: the spec recounts its entries on every call, on the robot runner's path.)
+  int obsDim() const { return maps_.obs_dim; }
+  int actDim() const { return maps_.act_dim; }
 
   nn::ParameterSet<S>& params() { return params_; }
   const nn::ParameterSet<S>& params() const { return params_; }
@@ -80,6 +81,9 @@ class ActorCritic {
   // V(o) only (1 x B, normalized value units): no policy work. Like actMean, it overwrites the
   // caches of forward(), so backward() must follow a fresh forward() (checked).
   Eigen::Map<const Mat<S>> criticValue(const ConstMatRef<S>& raw_obs);
+
+  // The shared per-agent policy (Phi and the agent maps), e.g. to count its FLOPs.
+  const SharedAgentPolicy<S>& policy() const { return policy_; }
 
   // The fused engine's chunk width of the policy and the critic networks, and what decided it
   // (nn/chunk_tuner.hpp): printed by the learner, so a run records what its CPU chose.

@@ -21,8 +21,21 @@ template <typename S>
 Eigen::Block<Mat<S>> SharedAgentPolicy<S>::forward(const ConstMatRef<S>& obs) {
   const int b = static_cast<int>(obs.cols());
   batch_ = b;
-  auto y = phi_.forward(stack_.build(obs));
-  agent_out_ = y.data();
+  agent_out_ = phi_.forward(stack_.build(obs)).data();
+  return combine(agent_out_, b);
+}
+
+template <typename S>
+Eigen::Block<Mat<S>> SharedAgentPolicy<S>::infer(const ConstMatRef<S>& obs) {
+  const int b = static_cast<int>(obs.cols());
+  agent_out_ = nullptr;  // Phi's caches for backward are gone
+  return combine(phi_.infer(stack_.build(obs)).data(), b);
+}
+
+template <typename S>
+Eigen::Block<Mat<S>> SharedAgentPolicy<S>::combine(const S* agent_out, int b) {
+  const Eigen::Index nb = static_cast<Eigen::Index>(maps_->num_agents) * b;
+  const Eigen::Map<const Mat<S>> y(agent_out, maps_->agent_output_dim, nb);
   if (mean_.cols() < b) mean_.resize(maps_->act_dim, b);
   auto mean = mean_.block(0, 0, mean_.rows(), b);
   mean.setZero();

@@ -19,6 +19,9 @@ class SharedAgentPolicy {
 
   // Mean action (act_dim x B) of normalized observations; caches for backward.
   Eigen::Block<Mat<S>> forward(const ConstMatRef<S>& obs);
+  // The same mean without caches for backward (actors, robot runner): Phi's inference path, no
+  // copy of the stacked input. Bit-identical to forward().
+  Eigen::Block<Mat<S>> infer(const ConstMatRef<S>& obs);
   // Per-agent outputs y_i of the last forward (agent_output_dim x N*B).
   Eigen::Map<const Mat<S>> agentOutputs() const;
 
@@ -38,6 +41,8 @@ class SharedAgentPolicy {
   Mat<S> mean_, dagent_, dstack_;
   const S* agent_out_ = nullptr;  // Phi's output of the last forward (contiguous leftCols block)
   int batch_ = 0;
+
+  Eigen::Block<Mat<S>> combine(const S* agent_out, int b);  // mean = sum_i Out_i y_i
 };
 
 }  // namespace masa::model

@@ -129,20 +129,34 @@ inline void panelTimesColumns(const float* __restrict a, Index lda, int depth, c
   const float* col[NR];
 #pragma GCC unroll 8
   for (int j = 0; j < NR; ++j) col[j] = b + j * ldb;
-  for (int k = 0; k < depth; ++k, a += lda) {
-    __m512 av[MV];
-#pragma GCC unroll 32
-    for (int i = 0; i < MV; ++i) {
-      av[i] = loadRow(a + i * kLanes, kMasked && i == MV - 1, mask);
-      // Wide narrow-column tiles: keep the loaded row in a register. Left alone, GCC folds the
-      // load into each of the NR FMAs, NR loads per vector of W, and the loop becomes load-bound.
-      if constexpr (MV > 3 && NR > 1) __asm__("" : "+v"(av[i]));
-    }
+  if constexpr (MV > 3) {
+    // Narrow tiles (up to 28 vectors x 1-4 columns): the NR broadcasts first, then one row of W
+    // at a time, used by all NR columns at once: MV x NR accumulators + NR + 1 registers. The
+    // empty asm keeps the row in a register; left alone, GCC folds the load into each of the NR
+    // FMAs, NR loads per vector of W, and the loop becomes load-bound.
+    for (int k = 0; k < depth; ++k, a += lda) {
+      __m512 bj[NR];
 #pragma GCC unroll 8
-    for (int j = 0; j < NR; ++j) {
-      const __m512 bj = _mm512_set1_ps(col[j][k]);
+      for (int j = 0; j < NR; ++j) bj[j] = _mm512_set1_ps(col[j][k]);
 #pragma GCC unroll 32
-      for (int i = 0; i < MV; ++i) acc[i][j] = _mm512_fmadd_ps(av[i], bj, acc[i][j]);
+      for (int i = 0; i < MV; ++i) {
+        __m512 av = loadRow(a + i * kLanes, kMasked && i == MV - 1, mask);
+        if constexpr (NR > 1) __asm__("" : "+v"(av));
+#pragma GCC unroll 8
+        for (int j = 0; j < NR; ++j) acc[i][j] = _mm512_fmadd_ps(av, bj[j], acc[i][j]);
+      }
+    }
+  } else {
+    for (int k = 0; k < depth; ++k, a += lda) {
+      __m512 av[MV];
+#pragma GCC unroll 3
+      for (int i = 0; i < MV; ++i) av[i] = loadRow(a + i * kLanes, kMasked && i == MV - 1, mask);
+#pragma GCC unroll 8
+      for (int j = 0; j < NR; ++j) {
+        const __m512 bj = _mm512_set1_ps(col[j][k]);
+#pragma GCC unroll 3
+        for (int i = 0; i < MV; ++i) acc[i][j] = _mm512_fmadd_ps(av[i], bj, acc[i][j]);
+      }
     }
   }
 }
