@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/nn/adam.hpp"
+#include "common/nn/dense_kernels.hpp"
 #include "common/nn/mlp.hpp"
 #include "machine_peak.hpp"
 
@@ -92,5 +93,26 @@ void BM_Infer(benchmark::State& state) {
 // 1: one agent (SA) in the robot runner; 2 and 4: a robot's agents (MASA: N columns a step); 16: a
 // small batch of environments.
 BENCHMARK(BM_Infer)->Arg(1)->Arg(2)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// One dense layer's forward over 1 or 2 columns (depth 400, ELU), rows 200 (a masked last vector,
+// columns starting mid cache line) and 400 (two row blocks at 2 columns): ns per weight, i.e.
+// how fast W streams from L2 (docs/benchmarks.md, issue #14).
+void BM_NarrowForward(benchmark::State& state) {
+  if (!masa::nn::dense::kAvailable) return state.SkipWithError("built without AVX-512");
+  const int rows = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1)), depth = 400;
+  const Mat<float> w = Mat<float>::Random(rows, depth) * 0.05f;
+  const Mat<float> x = Mat<float>::Random(depth, n), b = Mat<float>::Random(rows, 1);
+  Mat<float> y(rows, n);
+  for (auto _ : state) {
+    masa::nn::dense::forward(w.data(), rows, rows, depth, b.data(), masa::nn::Activation::kElu, x.data(), depth,
+                             y.data(), rows, n);
+    benchmark::DoNotOptimize(y.data());
+  }
+  state.counters["ns_per_weight"] = benchmark::Counter(static_cast<double>(rows) * depth * 1e-9,
+                                                       benchmark::Counter::kIsIterationInvariantRate |
+                                                           benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_NarrowForward)->ArgNames({"rows", "columns"})->ArgsProduct({{200, 208, 400}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 }  // namespace
