@@ -1,6 +1,7 @@
 // Register-tile kernels of dense_kernels.hpp. Every kernel walks its result in tiles of up to
 // 3 vectors (48 rows) x 8 columns; the tile loop keeps one small operand block in L1 (8 columns
-// of the batch, or 8 rows of x^T) and streams the weights (or g) from L2.
+// of the batch, or 8 rows of x^T) and streams the weights (or g) from L2. Forward over 1-4
+// columns (inference) uses narrow tiles of up to 28 vectors instead (forNarrowBlocks).
 
 // GCC 12's AVX-512 headers implement _mm512_min_ps and friends with an undefined pass-through
 // vector under an all-ones mask, which -Wuninitialized reports at every inlined use (also inside
