@@ -218,7 +218,7 @@ int buildFamilies(const std::string& run_arg, const std::string& out_arg, int ep
   std::ofstream md(out / "families.md"), csv(out / "families.csv");
   md << "# Offline datasets of " << run_arg << "\n\n"
      << "Built by `masa_dataset families " << run_arg << " --episodes " << episodes << " --seed " << seed
-     << (mean ? " --mean" : "") << "`; task " << expert_data.task << ", expert `" << expert << "`, weak `" << weak
+     << (weak_arg.empty() ? "" : " --weak " + weak_arg) << (mean ? " --mean" : "") << "`; task " << expert_data.task << ", expert `" << expert << "`, weak `" << weak
      << "`.\n\n| family | episodes | transitions | policies | return mean | return std | success |\n"
      << "|---|---:|---:|---:|---:|---:|---:|\n";
   csv << "family,file,episodes,transitions,policies,return_mean,return_std,success_rate,bytes\n";

@@ -30,8 +30,16 @@ info "$work/data/weak_expert.lcmlog" | grep -q "policy 1 run/policies/policy_u00
 [ "$(wc -l < "$work/data/families.csv")" -eq 5 ] || fail "families.csv should have a header and 4 rows"
 grep -q "^| mixed | 8 |" "$work/data/families.md" || fail "families.md lacks the mixed row: $(cat "$work/data/families.md")"
 
+# A chosen weak stage is recorded, and families.md names it in the command that rebuilds the table.
+"$tool" families "$work/run" --episodes 4 --weak "$work/run/policies/policy_u000002.bin" --out "$work/data3" \
+  > "$work/families3.log" 2>&1 || fail "families --weak failed: $(cat "$work/families3.log")"
+info "$work/data3/weak_expert.lcmlog" | grep -q "run/policies/policy_u000002.bin: 2 episodes" ||
+  fail "weak_expert is not half the chosen stage: $(info "$work/data3/weak_expert.lcmlog")"
+grep -q -- "--weak $work/run/policies/policy_u000002.bin" "$work/data3/families.md" ||
+  fail "families.md's command leaves out --weak: $(head -3 "$work/data3/families.md")"
+
 # A run without stages is refused with the fix.
 "$train" "${tiny[@]}" --set runner.snapshot_every=0 --run-dir "$work/plain" > "$work/train2.log" 2>&1 || fail "training failed"
 if "$tool" families "$work/plain" --episodes 4 --out "$work/data2" > "$work/err.log" 2>&1; then fail "families accepted a run with no stages"; fi
 grep -q "runner.snapshot_every" "$work/err.log" || fail "the error does not say how to keep stages: $(cat "$work/err.log")"
-echo "PASS: expert 8, half_expert 4 of the expert's, weak_expert 4 + 4, mixed from 4 policies (the last stage, identical to the final policy, once); a run without stages is refused"
+echo "PASS: expert 8, half_expert 4 of the expert's, weak_expert 4 + 4, mixed from 4 policies (the last stage, identical to the final policy, once); a chosen weak stage is recorded and named; a run without stages is refused"
