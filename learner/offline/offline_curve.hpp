@@ -9,8 +9,9 @@
 namespace masa::offline {
 
 // losses: metrics.csv columns drawn on the loss panel; figures: other columns of the algorithm
-// (means of Q, V, advantage, weights...), drawn on their own panel.
+// (means of Q, V, advantage, weights...), drawn on their own panel. evaluates: whether the run
+// evaluates at all (otherwise the evaluation panels say so instead of plotting empty columns).
 std::string offlineCurveScript(const std::string& title, const std::vector<std::string>& losses,
-                               const std::vector<std::string>& figures);
+                               const std::vector<std::string>& figures, bool evaluates);
 
 }  // namespace masa::offline

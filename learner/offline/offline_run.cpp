@@ -113,7 +113,9 @@ struct OfflineRun::Impl {
                               (oc.augment ? std::string("sasa-data") : model::methodName(rc.method)) + "  seed " +
                               std::to_string(rc.seed) + "  (" + std::to_string(data.size()) + " transitions)";
     curve = std::make_unique<learner::LearningCurve>(opt.run_dir,
-                                                     learner::LearningCurve::Script{offlineCurveScript(title, losses, figures)});
+                                                     learner::LearningCurve::Script{offlineCurveScript(
+                                                         title, losses, figures,
+                                                         oc.eval_every > 0 || oc.final_eval_episodes > 0)});
   }
 
   void step(const TransitionBatch<float>& batch) {

@@ -21,7 +21,9 @@ for case in "bc sasa-data" "iql masa"; do
   set -- $case
   out="$work/$1_$2"
   "$tool" "${tiny[@]}" --algo "$1" --method "$2" --out "$out" > "$work/$1.log" 2>&1 || fail "$1 $2 failed: $(cat "$work/$1.log")"
-  for f in config.yaml metrics.csv policy.bin eval.txt learning_curve.gp; do [ -s "$out/$f" ] || fail "$1 $2: no $f"; done
+  for f in config.yaml metrics.csv policy.bin eval.txt learning_curve.gp learning_curve.png; do
+    [ -s "$out/$f" ] || fail "$1 $2: no $f"
+  done
   grep -q "ETA" "$work/$1.log" || fail "$1 $2: no progress line: $(cat "$work/$1.log")"
   # 4 rows of losses (10, 20, 30, 40), the evaluation at 20 on its row, the final one last.
   [ "$(wc -l < "$out/metrics.csv")" -eq 6 ] || fail "$1 $2: metrics.csv has $(wc -l < "$out/metrics.csv") lines: $(cat "$out/metrics.csv")"
@@ -35,7 +37,11 @@ grep -q "equivariance checked on load" "$work/eval_iql.log" || fail "masa_eval d
 
 # --env-of: the recording policy's env section (the shipped A1 policy's reward weights), --set still on top.
 "$tool" "${tiny[@]}" --algo bc --method masa --env-of tasks/a1_beam/policy/policy.bin --set offline.final_eval_episodes=0 \
+  --set offline.eval_every=0 \
   --out "$work/env_of" > "$work/env_of.log" 2>&1 || fail "--env-of failed: $(cat "$work/env_of.log")"
+# No evaluation at all (as experiments/offline_table.sh trains): the curve is still drawn.
+[ -s "$work/env_of/learning_curve.png" ] && ! grep -q "gnuplot failed" "$work/env_of.log" ||
+  fail "a run without evaluation has no learning curve: $(grep gnuplot "$work/env_of.log")"
 grep -q "action: -0.05" "$work/env_of/config.yaml" && grep -q "max_episode_steps: 40" "$work/env_of/config.yaml" ||
   fail "--env-of did not take the policy's env under --set: $(grep -A3 '^env' "$work/env_of/config.yaml")"
 
