@@ -23,6 +23,7 @@
 #include "common/nn/adam.hpp"
 #include "common/nn/mlp.hpp"
 #include "machine_peak.hpp"
+#include "mlp_flops.hpp"
 
 namespace {
 
@@ -37,15 +38,6 @@ constexpr int kObs = 74, kAct = 21;
 const std::vector<int> kHidden{400, 200, 100};
 
 MlpShape shape(int output) { return MlpShape{kObs, kHidden, output, Activation::kElu, Activation::kIdentity}; }
-
-double flopsPerSample(const MlpShape& s) {
-  std::vector<int> w{s.input};
-  w.insert(w.end(), s.hidden.begin(), s.hidden.end());
-  w.push_back(s.output);
-  double f = 0;
-  for (size_t k = 0; k + 1 < w.size(); ++k) f += 6.0 * w[k] * w[k + 1];
-  return f - 2.0 * w[0] * w[1];  // no input gradient for the first layer
-}
 
 const bool kMachineDescribed = masa::bench::describeMachine();
 
@@ -119,8 +111,8 @@ void BM_LearnerStep(benchmark::State& state, bool with_critic) {
       state.SetIterationTime(dt);
       seconds += dt;
     }
-    double flops = flopsPerSample(shape(kAct));
-    if (with_critic) flops += flopsPerSample(shape(1));
+    double flops = masa::bench::trainingFlopsPerSample(shape(kAct));
+    if (with_critic) flops += masa::bench::trainingFlopsPerSample(shape(1));
     const double gflops = flops * batch * static_cast<double>(state.iterations()) * 1e-9 / seconds;
     state.SetItemsProcessed(state.iterations() * batch);
     state.counters["GFLOPs"] = gflops;

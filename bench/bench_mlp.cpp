@@ -9,6 +9,7 @@
 #include "common/nn/dense_kernels.hpp"
 #include "common/nn/mlp.hpp"
 #include "machine_peak.hpp"
+#include "mlp_flops.hpp"
 
 namespace {
 
@@ -26,15 +27,6 @@ MlpShape humanoidPolicy() {
   s.output = 21;
   s.hidden_activation = masa::nn::Activation::kElu;
   return s;
-}
-
-double forwardFlopsPerSample(const MlpShape& s) {
-  std::vector<int> w{s.input};
-  w.insert(w.end(), s.hidden.begin(), s.hidden.end());
-  w.push_back(s.output);
-  double f = 0;
-  for (size_t k = 0; k + 1 < w.size(); ++k) f += 2.0 * w[k] * w[k + 1];
-  return f;
 }
 
 const bool kMachineDescribed = masa::bench::describeMachine();
@@ -66,9 +58,7 @@ void BM_TrainStep(benchmark::State& state) {
     adam.step();
     benchmark::ClobberMemory();
   }
-  // Backward is twice the forward except the first layer's dx, which is not asked for: 731,000 here.
-  const int first_width = shape.hidden.empty() ? shape.output : shape.hidden.front();
-  report(state, B, 3 * forwardFlopsPerSample(shape) - 2.0 * shape.input * first_width);
+  report(state, B, masa::bench::trainingFlopsPerSample(shape));  // 731,000 here
 }
 BENCHMARK(BM_TrainStep)->Arg(1)->Arg(16)->Arg(4096)->Arg(32768)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
@@ -83,10 +73,10 @@ void BM_Infer(benchmark::State& state) {
   const Mat<float> x = Mat<float>::Random(shape.input, B);
   mlp.infer(x);
   for (auto _ : state) benchmark::DoNotOptimize(mlp.infer(x).data());
-  report(state, B, forwardFlopsPerSample(shape));
+  report(state, B, masa::bench::forwardFlopsPerSample(shape));
   // Inference runs on one thread at these sizes: of_peak is the share of one core's FMA peak, and
   // its inverse how far the time is from the FLOP bound.
-  const double gflops = forwardFlopsPerSample(shape) * B * static_cast<double>(state.iterations()) * 1e-9;
+  const double gflops = masa::bench::forwardFlopsPerSample(shape) * B * static_cast<double>(state.iterations()) * 1e-9;
   state.counters["of_peak"] =
       benchmark::Counter(gflops / masa::bench::measuredPeakGflops(1), benchmark::Counter::kIsRate);
 }

@@ -14,6 +14,7 @@
 
 #include "common/policy/policy_file.hpp"
 #include "machine_peak.hpp"
+#include "mlp_flops.hpp"
 
 namespace {
 
@@ -23,13 +24,7 @@ const std::vector<std::string> kTasks{"a1_beam", "ant_acrobatic", "trifinger_lif
                                       "humanoid_dribbling"};
 
 double phiFlopsPerObservation(const masa::model::ActorCritic<float>& model) {
-  const auto& shape = model.policy().net().shape();
-  std::vector<int> w{shape.input};
-  w.insert(w.end(), shape.hidden.begin(), shape.hidden.end());
-  w.push_back(shape.output);
-  double f = 0;
-  for (size_t k = 0; k + 1 < w.size(); ++k) f += 2.0 * w[k] * w[k + 1];
-  return f * model.policy().maps().num_agents;
+  return masa::bench::forwardFlopsPerSample(model.policy().net().shape()) * model.policy().maps().num_agents;
 }
 
 void BM_PolicyMean(benchmark::State& state) {
