@@ -3,7 +3,6 @@
 // the first layer's dx, which training does not compute; elementwise work is not counted.
 #include <benchmark/benchmark.h>
 
-#include <vector>
 
 #include "common/nn/adam.hpp"
 #include "common/nn/dense_kernels.hpp"
@@ -62,7 +61,7 @@ void BM_TrainStep(benchmark::State& state) {
 }
 BENCHMARK(BM_TrainStep)->Arg(1)->Arg(16)->Arg(4096)->Arg(32768)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
-void BM_Infer(benchmark::State& state) {
+void inferOn(benchmark::State& state, bool frozen) {
   const int B = static_cast<int>(state.range(0));
   const MlpShape shape = humanoidPolicy();
   ParameterSet<float> params;
@@ -70,6 +69,7 @@ void BM_Infer(benchmark::State& state) {
   params.finalize();
   masa::Rng rng(1);
   mlp.initialize(rng);
+  if (frozen) params.freeze();
   const Mat<float> x = Mat<float>::Random(shape.input, B);
   mlp.infer(x);
   for (auto _ : state) benchmark::DoNotOptimize(mlp.infer(x).data());
@@ -80,29 +80,41 @@ void BM_Infer(benchmark::State& state) {
   state.counters["of_peak"] =
       benchmark::Counter(gflops / masa::bench::measuredPeakGflops(1), benchmark::Counter::kIsRate);
 }
+void BM_Infer(benchmark::State& state) { inferOn(state, false); }
+// Frozen parameters (the robot runner): 1-4 columns read W packed for their column count.
+void BM_InferFrozen(benchmark::State& state) { inferOn(state, true); }
 // 1: one agent (SA) in the robot runner; 2 and 4: a robot's agents (MASA: N columns a step); 16: a
 // small batch of environments.
 BENCHMARK(BM_Infer)->Arg(1)->Arg(2)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_InferFrozen)->Arg(1)->Arg(2)->Arg(3)->Arg(4)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
-// One dense layer's forward over 1 or 2 columns (depth 400, ELU), rows 200 (a masked last vector,
-// columns starting mid cache line) and 400 (two row blocks at 2 columns): ns per weight, i.e.
-// how fast W streams from L2 (docs/benchmarks.md, issue #14).
+// One dense layer's forward over 1-4 columns (depth 400, ELU), rows 200 (a masked last vector,
+// columns starting mid cache line) and 400 (two row blocks at 2 columns), on W in place or packed
+// for the column count (dense::packForward): ns per weight, i.e. how fast W streams from L2
+// (docs/benchmarks.md, issue #14).
 void BM_NarrowForward(benchmark::State& state) {
   if (!masa::nn::dense::kAvailable) return state.SkipWithError("built without AVX-512");
   const int rows = static_cast<int>(state.range(0)), n = static_cast<int>(state.range(1)), depth = 400;
+  const bool packed = state.range(2) != 0;
   const Mat<float> w = Mat<float>::Random(rows, depth) * 0.05f;
   const Mat<float> x = Mat<float>::Random(depth, n), b = Mat<float>::Random(rows, 1);
+  masa::Vec<float> pack(masa::nn::dense::packedSize(rows, depth));  // 64-byte aligned, as Mlp's packs
+  masa::nn::dense::packForward(w.data(), rows, rows, depth, n, pack.data());
   Mat<float> y(rows, n);
   for (auto _ : state) {
-    masa::nn::dense::forward(w.data(), rows, rows, depth, b.data(), masa::nn::Activation::kElu, x.data(), depth,
-                             y.data(), rows, n);
+    if (packed)
+      masa::nn::dense::forwardPacked(pack.data(), rows, depth, b.data(), masa::nn::Activation::kElu, x.data(), depth,
+                                     y.data(), rows, n);
+    else
+      masa::nn::dense::forward(w.data(), rows, rows, depth, b.data(), masa::nn::Activation::kElu, x.data(), depth,
+                               y.data(), rows, n);
     benchmark::DoNotOptimize(y.data());
   }
   state.counters["ns_per_weight"] = benchmark::Counter(static_cast<double>(rows) * depth * 1e-9,
                                                        benchmark::Counter::kIsIterationInvariantRate |
                                                            benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_NarrowForward)->ArgNames({"rows", "columns"})->ArgsProduct({{200, 208, 400}, {1, 2}})
+BENCHMARK(BM_NarrowForward)->ArgNames({"rows", "columns", "packed"})->ArgsProduct({{200, 208, 400}, {1, 2, 3, 4}, {0, 1}})
     ->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 }  // namespace

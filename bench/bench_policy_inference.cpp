@@ -1,6 +1,7 @@
 // The policy mean of every shipped policy (tasks/<task>/policy/policy.bin) as the robot runner and
-// the actors compute it: ActorCritic::actMean on 1 observation (the runner's step: N agent columns
-// through Phi for MASA) and on 16 (a small batch of environments), on one thread (issue #14).
+// the actors compute it: ActorCritic::actMean on 1 observation (N agent columns through Phi for
+// MASA), on the actors' path and frozen as the robot runner runs it (weights packed for N columns),
+// and on 16 (a small batch of environments), on one thread (issue #14).
 //
 // FLOPs count Phi's products only (2 * in * out per layer and agent column); normalization, agent
 // stacking and the output maps are elementwise and not counted. of_peak = GFLOP/s over one core's
@@ -30,6 +31,7 @@ double phiFlopsPerObservation(const masa::model::ActorCritic<float>& model) {
 void BM_PolicyMean(benchmark::State& state) {
   const std::string& task = kTasks[static_cast<size_t>(state.range(0))];
   const int batch = static_cast<int>(state.range(1));
+  const bool frozen = state.range(2) != 0;
   const int saved_threads = omp_get_max_threads();
   omp_set_num_threads(1);
   {
@@ -39,7 +41,8 @@ void BM_PolicyMean(benchmark::State& state) {
     std::normal_distribution<float> normal(0.f, 1.f);
     masa::Mat<float> obs(lp.model->obsDim(), batch);
     for (float& v : obs.reshaped()) v = normal(rng);
-    lp.model->actMean(obs);  // buffers sized before the timing
+    if (frozen) lp.model->freezeForInference();  // as the robot runner does
+    lp.model->actMean(obs);                      // buffers (and packs) made before the timing
     for (auto _ : state) benchmark::DoNotOptimize(lp.model->actMean(obs).data());
     const double flops = phiFlopsPerObservation(*lp.model) * batch;
     const double gflops = flops * static_cast<double>(state.iterations()) * 1e-9;
@@ -53,8 +56,8 @@ void BM_PolicyMean(benchmark::State& state) {
 }
 
 void args(benchmark::internal::Benchmark* b) {
-  b->ArgNames({"task", "batch"});
-  for (int t = 0; t < static_cast<int>(kTasks.size()); ++t) b->Args({t, 1})->Args({t, 16});
+  b->ArgNames({"task", "batch", "frozen"});
+  for (int t = 0; t < static_cast<int>(kTasks.size()); ++t) b->Args({t, 1, 0})->Args({t, 1, 1})->Args({t, 16, 0});
   b->Unit(benchmark::kMicrosecond)->UseRealTime();
 }
 

@@ -92,6 +92,10 @@ class ActorCritic {
            critic_.featureNet().chunkTuner().summary();
   }
 
+  // For a policy that will only act from now on (the robot runner): the parameters can no longer be
+  // written (writes throw), and actMean on 1-4 agent columns reads weights packed once for it.
+  void freezeForInference() { params_.freeze(); }
+
   // Parameters and normalizer statistics, for checkpoints.
   void save(std::ostream& os) const;
   void load(std::istream& is, const std::string& source_name);

@@ -1,6 +1,7 @@
 #include "common/model/tied_log_std.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "common/core/check.hpp"
 
@@ -23,7 +24,7 @@ void TiedLogStd<S>::initialize(S value) {
 template <typename S>
 void TiedLogStd<S>::get(VecRef<S> log_std) const {
   MASA_CHECK(log_std.size() == actDim(), "log_std has " << log_std.size() << " entries, expected " << actDim());
-  const S* p = params_->values().data() + offset_;
+  const S* p = std::as_const(*params_).values().data() + offset_;
   for (int d = 0; d < actDim(); ++d) log_std(d) = p[classes_[d]];
 }
 

@@ -1,7 +1,8 @@
 // Register-tile kernels of dense_kernels.hpp. Every kernel walks its result in tiles of up to
 // 3 vectors (48 rows) x 8 columns; the tile loop keeps one small operand block in L1 (8 columns
 // of the batch, or 8 rows of x^T) and streams the weights (or g) from L2. Forward over 1-4
-// columns (inference) uses narrow tiles of up to 28 vectors instead (forNarrowBlocks).
+// columns (inference) uses narrow tiles of up to 28 vectors instead (forNarrowBlocks), on W in
+// place or on a copy packed block by block (packForward, forwardPacked).
 
 // GCC 12's AVX-512 headers implement _mm512_min_ps and friends with an undefined pass-through
 // vector under an all-ones mask, which -Wuninitialized reports at every inlined use (also inside
@@ -38,6 +39,28 @@ void forEachPanel(int rows, F&& f) {  // f(first row, vectors)
   for (int p = 0; p < threes; ++p, row0 += 3 * kLanes) f(row0, 3);
   for (int p = 0; p < twos; ++p, row0 += 2 * kLanes) f(row0, 2);
 }
+
+// Forward over few columns (single-sample inference, the robot runner's N agents, a batch's last
+// columns): a 3-vector panel would keep only 3 x NR FMA chains in flight, too few to hide the FMA
+// latency on two ports, and would stream W from L2 once per 48 rows. A narrow tile covers up to
+// narrowVectors(NR) vectors of rows (all 400 rows of a humanoid layer in one block when NR = 1)
+// in at most 28 + NR zmm registers, so W is read once.
+constexpr int narrowVectors(int nr) { return nr == 1 ? 28 : nr == 2 ? 14 : nr == 3 ? 9 : 6; }
+
+// Splits ceil(rows / 16) vectors into blocks of at most max_vectors, sized evenly (25 vectors with
+// 9 at most: 9, 8, 8). f(first row, vectors, last block).
+template <class F>
+void forEachNarrowBlock(int rows, int max_vectors, F&& f) {
+  const int vectors = (rows + kLanes - 1) / kLanes;
+  const int blocks = (vectors + max_vectors - 1) / max_vectors;
+  const int base = vectors / blocks, extra = vectors % blocks;
+  int row0 = 0;
+  for (int b = 0; b < blocks; ++b) {
+    const int mv = base + (b < extra ? 1 : 0);
+    f(row0, mv, b == blocks - 1);
+    row0 += mv * kLanes;
+  }
+}
 }  // namespace
 
 Index packedSize(int rows, int depth) {
@@ -61,6 +84,19 @@ void pack(const float* w, Index ld, bool transpose, int rows, int depth, float* 
       }
     }
     packed += static_cast<Index>(width) * depth;
+  });
+}
+
+void packForward(const float* w, Index ldw, int rows, int depth, int n, float* packed) {
+  MASA_CHECK(n >= 1 && n <= kMaxPackedColumns, "dense::packForward: " << n << " columns, expected 1 to "
+                                                                      << kMaxPackedColumns);
+  forEachNarrowBlock(rows, narrowVectors(n), [&](int r0, int vectors, bool) {
+    const int width = vectors * kLanes, valid = std::min(width, rows - r0);
+    float* dst = packed + static_cast<Index>(r0) * depth;
+    for (int k = 0; k < depth; ++k, dst += width) {
+      std::copy_n(w + r0 + static_cast<Index>(k) * ldw, valid, dst);
+      std::fill(dst + valid, dst + width, 0.f);
+    }
   });
 }
 
@@ -298,15 +334,10 @@ inline void forPanels(int rows, F&& f) {
   });
 }
 
-// Forward over few columns (single-sample inference, the robot runner's N agents, a batch's last
-// columns): a 3-vector panel would keep only 3 x NR FMA chains in flight, too few to hide the FMA
-// latency on two ports, and would stream W from L2 once per 48 rows. A narrow tile covers up to
-// kNarrowVectors<NR> vectors of rows (all 400 rows of a humanoid layer in one block when NR = 1)
-// in at most 28 + NR zmm registers, so W is read once, as one contiguous run per column.
-// Each result element is still summed over k in order from zero, exactly as in the 48 x 8 tile:
-// which tile computes a column changes no bit of it.
+// Narrow tiles (see narrowVectors) sum each result element over k in order from zero, exactly as
+// the 48 x 8 tile does: which tile computes a column changes no bit of it.
 template <int NR>
-inline constexpr int kNarrowVectors = NR == 1 ? 28 : NR == 2 ? 14 : NR == 3 ? 9 : 6;
+inline constexpr int kNarrowVectors = narrowVectors(NR);
 
 template <int kMax, int M = 1, class C>
 inline void dispatchVectors(int mv, C&& call) {
@@ -322,19 +353,14 @@ template <int kMax, class F>
 inline void forNarrowBlocks(int rows, F&& f) {
   const int vectors = (rows + kLanes - 1) / kLanes;
   const __mmask16 last = firstLanes(rows - (vectors - 1) * kLanes);
-  const int blocks = (vectors + kMax - 1) / kMax;
-  const int base = vectors / blocks, extra = vectors % blocks;
-  int row0 = 0;
-  for (int b = 0; b < blocks; ++b) {
-    const int mv = base + (b < extra ? 1 : 0);
-    const bool masked = b == blocks - 1 && rows % kLanes != 0;
+  forEachNarrowBlock(rows, kMax, [&](int row0, int mv, bool last_block) {
+    const bool masked = last_block && rows % kLanes != 0;
     const __mmask16 mask = masked ? last : __mmask16(0xFFFF);
     dispatchVectors<kMax>(mv, [&](auto m) {
       if (masked) f(m, std::true_type{}, row0, mask);
       else f(m, std::false_type{}, row0, mask);
     });
-    row0 += mv * kLanes;
-  }
+  });
 }
 
 template <Activation A>
@@ -351,6 +377,30 @@ void forwardAct(const float* w, Index ldw, int rows, int depth, const float* bia
     else
       forPanels(rows, tile);
   });
+}
+
+// forwardAct over exactly NR = n columns on a packForward pack: each block's rows of W are one
+// contiguous run (depth x MV * 16 floats), not MV * 16 floats in every column of W.
+template <Activation A, int NR>
+void forwardPackedAct(const float* packed, int rows, int depth, const float* bias, const float* x, Index ldx,
+                      float* y, Index ldy) {
+  forNarrowBlocks<kNarrowVectors<NR>>(rows, [&](auto mv, auto masked, int row0, __mmask16 mask) {
+    constexpr int MV = decltype(mv)::value;
+    forwardTile<A, MV, NR, decltype(masked)::value>(packed + static_cast<Index>(row0) * depth, MV * kLanes, depth,
+                                                    bias ? bias + row0 : nullptr, x, ldx, y + row0, ldy, mask);
+  });
+}
+
+template <Activation A>
+void forwardPackedCols(const float* packed, int rows, int depth, const float* bias, const float* x, Index ldx,
+                       float* y, Index ldy, int n) {
+  switch (n) {
+    case 1: return forwardPackedAct<A, 1>(packed, rows, depth, bias, x, ldx, y, ldy);
+    case 2: return forwardPackedAct<A, 2>(packed, rows, depth, bias, x, ldx, y, ldy);
+    case 3: return forwardPackedAct<A, 3>(packed, rows, depth, bias, x, ldx, y, ldy);
+    case 4: return forwardPackedAct<A, 4>(packed, rows, depth, bias, x, ldx, y, ldy);
+    default: MASA_CHECK(false, "dense::forwardPacked: " << n << " columns, expected 1 to " << kMaxPackedColumns);
+  }
 }
 
 template <Activation A>
@@ -376,6 +426,17 @@ void forward(const float* w, Index ldw, int rows, int depth, const float* bias, 
     case Activation::kElu: return forwardAct<Activation::kElu>(w, ldw, rows, depth, bias, x, ldx, y, ldy, n);
     case Activation::kTanh: return forwardAct<Activation::kTanh>(w, ldw, rows, depth, bias, x, ldx, y, ldy, n);
     case Activation::kRelu: return forwardAct<Activation::kRelu>(w, ldw, rows, depth, bias, x, ldx, y, ldy, n);
+  }
+}
+
+void forwardPacked(const float* packed, int rows, int depth, const float* bias, Activation act, const float* x,
+                   Index ldx, float* y, Index ldy, int n) {
+  switch (act) {
+    case Activation::kIdentity:
+      return forwardPackedCols<Activation::kIdentity>(packed, rows, depth, bias, x, ldx, y, ldy, n);
+    case Activation::kElu: return forwardPackedCols<Activation::kElu>(packed, rows, depth, bias, x, ldx, y, ldy, n);
+    case Activation::kTanh: return forwardPackedCols<Activation::kTanh>(packed, rows, depth, bias, x, ldx, y, ldy, n);
+    case Activation::kRelu: return forwardPackedCols<Activation::kRelu>(packed, rows, depth, bias, x, ldx, y, ldy, n);
   }
 }
 
@@ -415,6 +476,9 @@ void weightGrad(int rows, int cols, int n, const float* g, Index ldg, const floa
 
 void forward(const float*, Index, int, int, const float*, Activation, const float*, Index, float*, Index, int) {
   MASA_CHECK(false, "dense::forward needs AVX-512");
+}
+void forwardPacked(const float*, int, int, const float*, Activation, const float*, Index, float*, Index, int) {
+  MASA_CHECK(false, "dense::forwardPacked needs AVX-512");
 }
 void inputGrad(const float*, int, int, const float*, Index, Activation, const float*, Index, float*, Index, int) {
   MASA_CHECK(false, "dense::inputGrad needs AVX-512");

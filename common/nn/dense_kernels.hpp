@@ -44,6 +44,19 @@ void pack(const float* w, Index ld, bool transpose, int rows, int depth, float* 
 void forward(const float* w, Index ldw, int rows, int depth, const float* bias, Activation act, const float* x,
              Index ldx, float* y, Index ldy, int n);
 
+// Inference on parameters that do not change (a deployed policy) can read W from a copy packed for
+// its column count: forward over n <= 4 columns splits the rows into blocks of up to 28 vectors, and
+// on W in place each block reads a strided part of every column of W; packed, it reads one
+// contiguous run, which the hardware prefetchers follow (2 columns of a 400-row layer: 0.034 ->
+// 0.021 ns per weight on Zen 5).
+inline constexpr int kMaxPackedColumns = 4;
+// Packs W (rows x depth, ldw) for forwardPacked over n (1-4) columns, in packedSize(rows, depth)
+// floats, padded with zeros.
+void packForward(const float* w, Index ldw, int rows, int depth, int n, float* packed);
+// forward() over exactly n (1-4) columns, W from packForward(..., n, ...): bit-identical to it.
+void forwardPacked(const float* packed, int rows, int depth, const float* bias, Activation act, const float* x,
+                   Index ldx, float* y, Index ldy, int n);
+
 // d = (P g) .* f'(y) for n columns, f' of `act` written in terms of y (y unused for identity).
 // P: packed rows x depth (W^T); g: depth x n (ldg); y, d: rows x n (ldy, ldd). d may not alias g.
 void inputGrad(const float* packed, int rows, int depth, const float* g, Index ldg, Activation act, const float* y,

@@ -167,10 +167,14 @@ Eigen::Block<Mat<S>> Mlp<S>::infer(const ConstMatRef<S>& x) {
   reserve(B);
   // Reads x directly and overwrites the activations: backward is no longer valid.
   batch_ = -1;
-  if constexpr (kFused)
-    forwardFused(x.data(), x.outerStride(), B, false);
-  else
+  if constexpr (kFused) {
+    if (params_->frozen() && B >= 1 && B <= dense::kMaxPackedColumns)
+      inferPacked(x.data(), x.outerStride(), B);
+    else
+      forwardFused(x.data(), x.outerStride(), B, false);
+  } else {
     forwardGeneric(x.data(), x.outerStride(), B);
+  }
   return y_.back().block(0, 0, shape_.output, B);
 }
 
@@ -201,8 +205,8 @@ void Mlp<S>::forwardGeneric(const S* x, Index ldx, int B) {
   Index ld_prev = ldx;
   for (size_t k = 0; k < layers_.size(); ++k) {
     const Layer& l = layers_[k];
-    auto W = params_->value(l.w_offset, l.out, l.in);
-    auto b = params_->value(l.b_offset, l.out, 1);
+    auto W = std::as_const(*params_).value(l.w_offset, l.out, l.in);
+    auto b = std::as_const(*params_).value(l.b_offset, l.out, 1);
     Mat<S>& y_store = y_[k];
     gemm_.run(plans_[3 * k], false, false, l.out, B, l.in, W.data(), l.out, prev, ld_prev, y_store.data(),
               y_store.rows(), false);
@@ -231,7 +235,7 @@ void Mlp<S>::backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx) {
   for (int k = L - 1; k >= 0; --k) {
     const Layer& l = layers_[k];
     auto dz = cur->topLeftCorner(l.out, B);
-    auto W = params_->value(l.w_offset, l.out, l.in);
+    auto W = std::as_const(*params_).value(l.w_offset, l.out, l.in);
     const Mat<S>& prev = k == 0 ? input_ : y_[k - 1];
     // dW += dz prev^T, db += row sums of dz, dprev = W^T dz.
     gemm_.run(plans_[3 * k + 1], false, true, l.out, l.in, B, dz.data(), cur->rows(), prev.data(), prev.rows(),
@@ -263,7 +267,7 @@ void Mlp<S>::backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx) {
 template <typename S>
 void Mlp<S>::forwardFused(const S* x, Index ldx, int B, bool keep_input) {
   if constexpr (kFused) {
-    const S* values = params_->values().data();
+    const S* values = std::as_const(*params_).values().data();
     const int L = numLayers();
     const int width = chunk_tuner_.width(backwardColumnsPerThread(B));
     auto chunk = [&](int j0) {
@@ -297,11 +301,40 @@ void Mlp<S>::forwardFused(const S* x, Index ldx, int B, bool keep_input) {
 }
 
 template <typename S>
+void Mlp<S>::inferPacked(const S* x, Index ldx, int n) {
+  if constexpr (kFused) {
+    const S* values = std::as_const(*params_).values().data();
+    Vec<S>& pack = inference_pack_[n - 1];
+    if (pack.size() == 0) {
+      Index size = 0;
+      for (const Layer& l : layers_) size += dense::packedSize(l.out, l.in);
+      pack.resize(size);
+      S* at = pack.data();
+      for (const Layer& l : layers_) {
+        dense::packForward(values + l.w_offset, l.out, l.out, l.in, n, at);
+        at += dense::packedSize(l.out, l.in);
+      }
+    }
+    const S* w = pack.data();
+    const S* in = x;
+    Index ld_in = ldx;
+    for (int k = 0; k < numLayers(); ++k) {
+      const Layer& l = layers_[k];
+      const Index ld_out = y_[k].rows();
+      dense::forwardPacked(w, l.out, l.in, values + l.b_offset, l.act, in, ld_in, y_[k].data(), ld_out, n);
+      w += dense::packedSize(l.out, l.in);
+      in = y_[k].data();
+      ld_in = ld_out;
+    }
+  }
+}
+
+template <typename S>
 void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
   if constexpr (kFused) {
     const int B = batch_;
     const int L = numLayers();
-    const S* values = params_->values().data();
+    const S* values = std::as_const(*params_).values().data();
     for (int k = dx ? 0 : 1; k < L; ++k) {
       const Layer& l = layers_[k];
       dense::pack(values + l.w_offset, l.out, true, l.in, l.out, packed_t_.data() + packed_t_offset_[k]);

@@ -15,6 +15,7 @@
 // every column starts 64-byte aligned.
 #pragma once
 
+#include <array>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -56,7 +57,9 @@ class Mlp {
   // Forward on x (input x B). Caches what backward needs; returns the output (output x B), a view
   // valid until the next forward.
   Eigen::Block<Mat<S>> forward(const ConstMatRef<S>& x);
-  // Forward without caching for backward (inference; may still use internal buffers).
+  // Forward without caching for backward (inference; may still use internal buffers). On frozen
+  // parameters (ParameterSet::freeze) 1-4 columns read every W from a copy packed for that column
+  // count on first use (dense::packForward): bit-identical, and faster (the robot runner's step).
   Eigen::Block<Mat<S>> infer(const ConstMatRef<S>& x);
 
   // Backward of the last forward: grads += dL/dparams; if dx is given, dx = dL/dx (input x B).
@@ -78,6 +81,7 @@ class Mlp {
   void backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx);
   void forwardFused(const S* x, Eigen::Index ldx, int B, bool keep_input);
   void backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx);
+  void inferPacked(const S* x, Eigen::Index ldx, int n);
   // Threads for a batch of B columns (1 inside a parallel region or for small batches).
   int threadsFor(int B, int min_columns_per_thread) const;
   // Columns per thread of a backward over B columns (what the chunk tuner sizes against).
@@ -106,6 +110,9 @@ class Mlp {
   std::vector<Vec<S>> grad_partial_;
   int param_begin_ = 0;
   ChunkTuner chunk_tuner_;
+  // Per column count n = 1..4: every layer's W packed for inference over n columns, one after the
+  // other; built on the first such infer() of frozen parameters, so never stale.
+  std::array<Vec<S>, dense::kMaxPackedColumns> inference_pack_;
   double forward_seconds_ = 0;  // of the last training forward, for the tuner
 };
 

@@ -47,6 +47,7 @@ void checkView(bool finalized, int size, int offset, int rows, int cols) {
 template <typename S>
 Eigen::Map<Mat<S>> ParameterSet<S>::value(int offset, int rows, int cols) {
   checkView(finalized_, size_, offset, rows, cols);
+  MASA_CHECK(!frozen_, "the parameters are frozen for inference and cannot be written");
   return Eigen::Map<Mat<S>>(values_.data() + offset, rows, cols);
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/core/check.hpp"
 #include "common/core/types.hpp"
 
 namespace masa::nn {
@@ -33,7 +34,15 @@ class ParameterSet {
   const std::vector<ParameterSegment>& segments() const { return segments_; }
   const ParameterSegment& segment(const std::string& name) const;  // throws if unknown
 
-  Vec<S>& values() { return values_; }
+  // A frozen set (a deployed policy's) can no longer be written: the mutable accessors throw, so
+  // inference may keep packed copies of the weights (Mlp::infer) without their going stale.
+  void freeze() { frozen_ = true; }
+  bool frozen() const { return frozen_; }
+
+  Vec<S>& values() {
+    MASA_CHECK(!frozen_, "the parameters are frozen for inference and cannot be written");
+    return values_;
+  }
   const Vec<S>& values() const { return values_; }
   Vec<S>& grads() { return grads_; }
   const Vec<S>& grads() const { return grads_; }
@@ -48,6 +57,7 @@ class ParameterSet {
   std::vector<ParameterSegment> segments_;
   int size_ = 0;
   bool finalized_ = false;
+  bool frozen_ = false;
   Vec<S> values_;
   Vec<S> grads_;
 };

@@ -23,6 +23,8 @@ SparseMap::SparseMap(int rows, int cols, const std::vector<Triplet>& triplets) :
     row_start_.push_back(static_cast<int>(col_.size()));
   }
   value_f_.assign(value_d_.begin(), value_d_.end());
+  one_per_row_ = nonZeros() == rows_;
+  for (int r = 0; r < rows_ && one_per_row_; ++r) one_per_row_ = row_start_[r] == r;
 }
 
 SparseMap SparseMap::identity(int n) {

@@ -60,6 +60,9 @@ class SparseMap {
   std::vector<int> col_;
   std::vector<double> value_d_;
   std::vector<float> value_f_;
+  // Every row has exactly one nonzero (a signed permutation or a selection): entry r is row r, and
+  // apply() runs one branch-free loop (the robot runner's agent stack, a few hundred rows a step).
+  bool one_per_row_ = false;
 };
 
 template <typename S>
@@ -72,6 +75,10 @@ void SparseMap::apply(const ConstMatRef<S>& in, MatRef<S> out) const {
   for (Eigen::Index b = 0; b < in.cols(); ++b) {
     const S* x = in.col(b).data();
     S* y = out.col(b).data();
+    if (one_per_row_) {  // S(0) + ...: the same bits as the general loop, -0 included
+      for (int r = 0; r < rows_; ++r) y[r] = S(0) + v[r] * x[col_[r]];
+      continue;
+    }
     for (int r = 0; r < rows_; ++r) {
       S acc = S(0);
       for (int k = row_start_[r]; k < row_start_[r + 1]; ++k) acc += v[k] * x[col_[k]];
@@ -89,6 +96,10 @@ void SparseMap::applyAdd(const ConstMatRef<S>& in, MatRef<S> out) const {
   for (Eigen::Index b = 0; b < in.cols(); ++b) {
     const S* x = in.col(b).data();
     S* y = out.col(b).data();
+    if (one_per_row_) {
+      for (int r = 0; r < rows_; ++r) y[r] += S(0) + v[r] * x[col_[r]];
+      continue;
+    }
     for (int r = 0; r < rows_; ++r) {
       S acc = S(0);
       for (int k = row_start_[r]; k < row_start_[r + 1]; ++k) acc += v[k] * x[col_[k]];

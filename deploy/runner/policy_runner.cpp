@@ -81,7 +81,9 @@ PolicyRunner::PolicyRunner(policy::LoadedPolicy& policy, const DeployConfig& con
   period_us_ = std::max<int64_t>(1, std::llround(period_s * 1e6));
   stale_us_ = std::max<int64_t>(1, std::llround(cfg_.stale_after_s * 1e6));
   settle_commands_ = static_cast<int>(std::ceil(cfg_.calibration_settle_s / period_s - 1e-9));
-  // One inference now, so that the network's buffers exist before the first command.
+  // The weights never change on the robot: frozen, inference reads them packed for its agent
+  // columns. One inference now, so that the packs and buffers exist before the first command.
+  model_->freezeForInference();
   obs_ = Mat<float>::Zero(task_->obsDim(), 1);
   model_->actMean(obs_);
 }

@@ -103,6 +103,23 @@ TEST(DeployRunner, ObservationFromAStateMessageEqualsTheTasksOwnInSimulation) {
   }
 }
 
+// The runner freezes the policy it runs (its weights are packed once for the agent columns) and
+// acts with the bits of the same policy unfrozen, as the actors and the evaluation run it.
+TEST(DeployRunner, FreezesItsPolicyAndActsWithTheBitsOfTheUnfrozenPolicy) {
+  Fixture f;
+  PolicyRunner r(f.lp, testConfig(), 1);
+  EXPECT_THROW(f.lp.model->params().values(), std::exception);
+  policy::LoadedPolicy unfrozen = policy::loadPolicyFile(kPolicy);
+  Rng rng(5);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
+  Mat<float> obs(f.lp.model->obsDim(), 1);
+  for (int t = 0; t < 10; ++t) {
+    for (float& x : obs.reshaped()) x = noise(rng);
+    const Mat<float> frozen_mean = f.lp.model->actMean(obs);
+    EXPECT_TRUE(frozen_mean == unfrozen.model->actMean(obs)) << "observation " << t;
+  }
+}
+
 // The humanoid is torque-controlled: its joint command is the motor torque the task applies for
 // the same action (gains zero), and its observation from a state message is the task's own.
 TEST(DeployRunner, HumanoidJointCommandIsTheTasksMotorTorqueAndItsObservationTheTasksOwn) {

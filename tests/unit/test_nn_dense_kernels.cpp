@@ -6,6 +6,8 @@
 
 #include <memory>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "common/nn/dense_kernels.hpp"
 #include "common/nn/mlp.hpp"
@@ -144,6 +146,54 @@ TEST(DenseKernelsForward, AColumnIsBitIdenticalWhateverTileComputesIt) {
   }
 }
 
+// The robot runner's path: W packed for its column count gives the bits of W read in place, for
+// 1-4 columns, blocks of every size (450 rows: two blocks even for one column), strided x and y,
+// every activation, and rows of y beyond `rows` left alone.
+TEST(DenseKernelsForward, PackedWeightsGiveTheBitsOfWInPlace) {
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  for (const int rows : {7, 21, 100, 400, 450}) {
+    const int depth = 37, ldx = depth + 3, ldy = rows + 5;
+    const Mat<float> w = Mat<float>::Random(rows, depth);
+    const Mat<float> bias = Mat<float>::Random(rows, 1);
+    const Mat<float> x = Mat<float>::Random(ldx, 4);
+    for (int n = 1; n <= dense::kMaxPackedColumns; ++n) {
+      std::vector<float> packed(dense::packedSize(rows, depth));
+      dense::packForward(w.data(), rows, rows, depth, n, packed.data());
+      for (const Activation a : {Activation::kIdentity, Activation::kElu, Activation::kTanh, Activation::kRelu}) {
+        Mat<float> in_place = Mat<float>::Constant(ldy, n, 7.f), from_pack = Mat<float>::Constant(ldy, n, 7.f);
+        dense::forward(w.data(), rows, rows, depth, bias.data(), a, x.data(), ldx, in_place.data(), ldy, n);
+        dense::forwardPacked(packed.data(), rows, depth, bias.data(), a, x.data(), ldx, from_pack.data(), ldy, n);
+        EXPECT_TRUE(from_pack == in_place) << rows << " rows, " << n << " columns, " << activationName(a);
+        EXPECT_TRUE((from_pack.bottomRows(ldy - rows).array() == 7.f).all()) << "wrote below row " << rows;
+      }
+    }
+  }
+}
+
+TEST(DenseKernelsPack, ForwardPackHoldsEachRowBlockContiguouslyZeroPadded) {
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  const int depth = 3;
+  {  // 70 rows = 5 vectors: one block for 4 columns (at most 6 vectors), 10 rows of zeros
+    const Mat<float> w = Mat<float>::Random(70, depth);
+    std::vector<float> packed(dense::packedSize(70, depth), -1.f);
+    dense::packForward(w.data(), 70, 70, depth, 4, packed.data());
+    for (int k = 0; k < depth; ++k)
+      for (int r = 0; r < 80; ++r) EXPECT_EQ(packed[k * 80 + r], r < 70 ? w(r, k) : 0.f);
+  }
+  {  // 400 rows = 25 vectors, 2 columns (at most 14): blocks of 13 and 12 vectors, each contiguous
+    const Mat<float> w = Mat<float>::Random(400, depth);
+    std::vector<float> packed(dense::packedSize(400, depth), -1.f);
+    dense::packForward(w.data(), 400, 400, depth, 2, packed.data());
+    for (int k = 0; k < depth; ++k) {
+      for (int r = 0; r < 208; ++r) EXPECT_EQ(packed[k * 208 + r], w(r, k));
+      for (int r = 0; r < 192; ++r) EXPECT_EQ(packed[208 * depth + k * 192 + r], w(208 + r, k));
+    }
+  }
+  float unused[16];
+  EXPECT_THROW(dense::packForward(unused, 1, 1, 1, 5, unused), std::exception);
+  EXPECT_THROW(dense::packForward(unused, 1, 1, 1, 0, unused), std::exception);
+}
+
 TEST(DenseKernelsPack, PanelsHoldRowsOfOpWZeroPadded) {
   if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
   // 70 rows = 5 vectors = one 48-row panel and one 32-row panel (22 valid rows).
@@ -199,6 +249,28 @@ TEST(MlpFusedEngine, MatchesTheGenericEngineInDoubleForTheHumanoidPolicy) {
   const MlpShape shape{74, {400, 200, 100}, 21, Activation::kElu, Activation::kIdentity};
   for (int batch : {1, 13, 300, 1000}) expectFusedMatchesGeneric(shape, batch, 2);
   expectFusedMatchesGeneric(shape, 777, 1);
+}
+
+// Frozen parameters: 1-4 columns read packed weights (built on first use), with the bits of the
+// unfrozen path; 5 columns and more the batch path; and nothing can write the weights any more,
+// so the packs cannot go stale.
+TEST(MlpFusedEngine, FrozenParametersInferWithTheSameBitsAndRefuseWrites) {
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  ParameterSet<float> params;
+  Mlp<float> net(params, "net", MlpShape{74, {400, 200, 100}, 21, Activation::kElu, Activation::kIdentity});
+  Rng rng(3);
+  net.initialize(rng, 1.f);
+  const Mat<float> x = Mat<float>::Random(74, 6);
+  std::vector<Mat<float>> before;
+  for (int n = 1; n <= 6; ++n) before.emplace_back(net.infer(x.leftCols(n)));
+  params.freeze();
+  for (int round = 0; round < 2; ++round)  // packs built, then reused
+    for (int n = 1; n <= 6; ++n)
+      EXPECT_TRUE(Mat<float>(net.infer(x.leftCols(n))) == before[n - 1]) << n << " columns, round " << round;
+  EXPECT_TRUE(params.frozen());
+  EXPECT_THROW(params.values(), std::exception);
+  EXPECT_THROW(params.value(0, 1, 1), std::exception);
+  EXPECT_EQ(std::as_const(params).values().size(), params.size());  // reading stays allowed
 }
 
 TEST(MlpFusedEngine, MatchesTheGenericEngineForOtherActivationsAndWidths) {

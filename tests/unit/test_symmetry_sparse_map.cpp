@@ -1,6 +1,9 @@
 // SparseMap against dense Eigen products on random data.
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <random>
 
 #include "common/symmetry/sparse_map.hpp"
@@ -38,6 +41,32 @@ TEST(SparseMapTest, ApplyMatchesDenseProduct) {
   Eigen::MatrixXf yf(7, 9);
   m.apply<float>(xf, yf);
   EXPECT_LT((yf - (m.toDense() * x).cast<float>()).cwiseAbs().maxCoeff(), 1e-5f);
+}
+
+// A signed permutation (one nonzero per row) takes apply()'s branch-free loop; the same rows inside
+// a map with a two-nonzero row take the general one. Their bits agree, signed zeros included.
+TEST(SparseMapTest, OneNonzeroPerRowGivesTheBitsOfTheGeneralLoop) {
+  const std::vector<Triplet> perm{{0, 2, -1.0}, {1, 0, 1.0}, {2, 3, -0.5}, {3, 1, 1.0}};
+  std::vector<Triplet> general = perm;
+  general.push_back({4, 0, 1.0});
+  general.push_back({4, 1, 1.0});
+  const SparseMap fast(4, 4, perm), slow(5, 4, general);
+  Eigen::MatrixXf x = Eigen::MatrixXf::Random(4, 3);
+  x(0, 0) = -0.f;  // v * x = -0 in row 1 (and +0 in rows with v < 0)
+  x(2, 1) = 0.f;
+  Eigen::MatrixXf y_fast(4, 3), y_slow(5, 3), add_fast = Eigen::MatrixXf::Constant(4, 3, -0.f),
+      add_slow = Eigen::MatrixXf::Constant(5, 3, -0.f);
+  fast.apply<float>(x, y_fast);
+  slow.apply<float>(x, y_slow);
+  fast.applyAdd<float>(x, add_fast);
+  slow.applyAdd<float>(x, add_slow);
+  for (int j = 0; j < 3; ++j)
+    for (int r = 0; r < 4; ++r) {
+      EXPECT_EQ(std::bit_cast<uint32_t>(y_fast(r, j)), std::bit_cast<uint32_t>(y_slow(r, j))) << r << "," << j;
+      EXPECT_EQ(std::bit_cast<uint32_t>(add_fast(r, j)), std::bit_cast<uint32_t>(add_slow(r, j))) << r << "," << j;
+    }
+  EXPECT_EQ(y_fast(1, 0), 0.f);
+  EXPECT_FALSE(std::signbit(y_fast(1, 0)));  // 0 + (-0) = +0, as the general loop's sum gives
 }
 
 TEST(SparseMapTest, ApplyAddAccumulatesIntoOutput) {
