@@ -5,9 +5,13 @@
 #   experiments/grid.sh --tasks "a1_beam" --methods "masa sa sasa ma" --seeds "0 1 2 3 4" \
 #       [--updates N] [--no-recipe] [--jobs N] [--threads T] [--hosts FILE] [--out DIR] [--set key=value ...]
 #   experiments/grid.sh --replot --out DIR      (only the comparison of an existing grid)
+#   experiments/grid.sh --extend N --out DIR    (the grid's runs go on to N updates each)
 # Resumable: run the same command again (or with --out DIR) after a kill. A finished run (its
 # `done` file) is not redone, a run with a checkpoint goes on from it, the rest start afresh.
 # Runs are taken seed by seed, so a grid stopped early has whole seeds of every method.
+# --extend N raises the grid's updates to N: every run goes on from its checkpoint (as after a
+# kill, the environments restart from a reset there, so an extended run is not bit-identical to
+# one trained to N from the start); grid.txt records when and from how many.
 # Results: DIR/<task>/<method>_s<seed>/ (run directories: config.yaml, metrics.csv, policy.bin, ...,
 # and <method>_s<seed>.log), DIR/grid.txt (the grid), DIR/<task>/compare*.png and verdict.md.
 # --hosts FILE: one line per host, "name [slots]" ("localhost" runs here). Remote hosts need this
@@ -22,7 +26,7 @@ repo=$(pwd)
 # --out and --hosts are the caller's paths; MASA_BUILD_DIR is relative to the checkout.
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
 
-tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1
+tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1 extend=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --tasks) tasks=$2; shift 2 ;;
@@ -36,7 +40,8 @@ while [ $# -gt 0 ]; do
     --set) sets+=("$2"); shift 2 ;;
     --no-recipe) recipe=0; shift ;;
     --replot) replot=1; shift ;;
-    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --extend) extend=$2; shift 2 ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -44,6 +49,25 @@ done
 [ -n "$hosts" ] && hosts=$(abs "$hosts")
 build=${MASA_BUILD_DIR:-build}
 [ -x "$build/tools/masa_train" ] || { echo "grid.sh: $build/tools/masa_train is missing: run scripts/build.sh first" >&2; exit 2; }
+
+# --extend: the grid in DIR, locked like a running grid (see below), gets the new number of
+# updates, and its finished runs lose their `done` marks; the rest is a resume.
+if [ -n "$extend" ]; then
+  [ -n "$out" ] && [ -f "$out/grid.txt" ] || { echo "grid.sh: --extend needs --out with an existing grid (its grid.txt)" >&2; exit 2; }
+  [[ "$extend" =~ ^[1-9][0-9]*$ ]] || { echo "grid.sh: --extend takes a number of updates, not '$extend'" >&2; exit 2; }
+  if [ -n "$tasks$methods$seeds$updates" ] || [ ${#sets[@]} -gt 0 ] || [ "$replot" = 1 ]; then
+    echo "grid.sh: --extend changes only the updates of the grid in --out: give it no other grid options" >&2; exit 2
+  fi
+  have=$(sed -n 's/^updates=//p' "$out/grid.txt")
+  [ -n "$have" ] || { echo "grid.sh: $out's runs follow each recipe's ppo.max_epochs (no --updates); --extend needs a number to go on from" >&2; exit 2; }
+  [ "$extend" -gt "$have" ] || { echo "grid.sh: $out's runs already go to $have updates; --extend $extend must be more" >&2; exit 2; }
+  exec {grid_lock}> "$out/.grid.lock"
+  flock -n "$grid_lock" || { echo "grid.sh: another grid is running in $out (wait for it, or stop it first)" >&2; exit 3; }
+  sed -i "s/^updates=.*/updates=$extend/" "$out/grid.txt"
+  echo "# extended from $have to $extend updates $(date -u +%FT%TZ) at commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)" >> "$out/grid.txt"
+  find "$out" -mindepth 3 -maxdepth 3 -name done -delete
+  echo "grid.sh: $out extended from $have to $extend updates a run"
+fi
 
 # The grid's definition is kept in DIR/grid.txt: a rerun with --out DIR and no grid options
 # continues it, and a rerun that names a different grid for the same DIR is refused.
@@ -78,10 +102,12 @@ fi
 out=$(cd "$out" && pwd)
 # One grid per directory: a second one (a command given twice) would start the same runs afresh
 # over the first's. The lock is held until this script exits.
-exec {grid_lock}> "$out/.grid.lock"
-if ! flock -n "$grid_lock"; then
-  echo "grid.sh: another grid is running in $out (wait for it, or stop it first)" >&2
-  exit 3
+if [ -z "$extend" ]; then
+  exec {grid_lock}> "$out/.grid.lock"
+  if ! flock -n "$grid_lock"; then
+    echo "grid.sh: another grid is running in $out (wait for it, or stop it first)" >&2
+    exit 3
+  fi
 fi
 
 if [ "$replot" = 0 ]; then

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # experiments/grid.sh as a user meets it: a grid of 2 tiny runs killed during its first run goes
 # on from that run's checkpoint when the same command is given again (not from the start), finishes
-# both, does not redo finished runs on a third call, and draws the comparison (masa_compare).
+# both, does not redo finished runs on a third call, draws the comparison (masa_compare), and goes
+# on to more updates with --extend.
 #   tests/experiments/grid_resume.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$(cd "$1" && pwd) work=$2
@@ -61,6 +62,24 @@ grep -q "2 already done" grid3.out || fail "the third call did not see both runs
 "$src/experiments/grid.sh" --replot --out grid > grid4.out 2>&1 || fail "--replot failed"
 "$src/experiments/grid.sh" --out grid --seeds "0 1" > grid5.out 2>&1 && fail "a different grid in the same directory was accepted"
 grep -q "is the grid seeds='0', not '0 1'" grid5.out || fail "the refusal does not say why: $(cat grid5.out)"
+# 3b. --extend: the finished grid goes on to 160 updates, both runs from their checkpoints at 150;
+# fewer updates, or other grid options with it, are refused with the reason.
+"$src/experiments/grid.sh" --extend 150 --out grid > grid_ext0.out 2>&1 && fail "--extend to the grid's own 150 updates was accepted"
+grep -q "already go to 150 updates; --extend 150 must be more" grid_ext0.out || fail "no reason given: $(cat grid_ext0.out)"
+"$src/experiments/grid.sh" --extend 160 --seeds 1 --out grid > grid_ext1.out 2>&1 && fail "--extend with --seeds was accepted"
+grep -q "give it no other grid options" grid_ext1.out || fail "no reason given: $(cat grid_ext1.out)"
+"$src/experiments/grid.sh" --extend 160 --out grid > grid_ext.out 2>&1 || fail "--extend failed"
+grep -q "extended from 150 to 160 updates" grid_ext.out || fail "--extend did not say what it did"
+grep -q "^updates=160$" grid/grid.txt && grep -q "^# extended from 150 to 160 updates" grid/grid.txt || \
+  fail "grid.txt does not record the extension"
+for m in masa sa; do
+  [ -f "grid/a1_beam/${m}_s0/done" ] || fail "the extended $m run is not marked done"
+  grep -q -- "--updates 160 --resume .*${m}_s0" "grid/a1_beam/${m}_s0.log" || fail "$m was not resumed to 160 updates"
+  awk -F, 'NR > 1 && $1 != NR - 2 { bad = 1 } END { exit bad || NR != 161 }' "grid/a1_beam/${m}_s0/metrics.csv" || \
+    fail "$m's epochs are not 0..159 in order"
+done
+[ -s grid/verdict.md ] || fail "the extended grid did not redo the comparison"
+
 # 4. Over a hosts file: every run goes through MASA_SSH and its directory through MASA_RSYNC (here
 # stand-ins that run on this machine and log what they were asked to do).
 cat > fake_ssh.sh <<'SH'
@@ -79,4 +98,4 @@ grep -q "2 at a time" grid6.out || fail "the hosts file's 2 slots were not used"
 [ "$(grep -c '^ssh far-host .*masa_train' remote.log)" -eq 2 ] || fail "the runs did not go through ssh to far-host"
 grep -q "^rsync -a far-host:$PWD/remote/a1_beam/masa_s0/ $PWD/remote/a1_beam/masa_s0/" remote.log || \
   fail "masa's run directory was not copied back"
-echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, hosts file used"
+echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, hosts file used"
