@@ -6,6 +6,7 @@
 #       [--updates N] [--no-recipe] [--jobs N] [--threads T] [--hosts FILE] [--out DIR] [--set key=value ...]
 #   experiments/grid.sh --replot --out DIR      (only the comparison of an existing grid)
 #   experiments/grid.sh --extend N --out DIR    (the grid's runs go on to N updates each)
+#   experiments/grid.sh --status --out DIR      (each run's progress and the grid's ETA)
 # Resumable: run the same command again (or with --out DIR) after a kill. A finished run (its
 # `done` file) is not redone, a run with a checkpoint goes on from it, the rest start afresh.
 # Runs are taken seed by seed, so a grid stopped early has whole seeds of every method.
@@ -27,6 +28,7 @@ repo=$(pwd)
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
 
 tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1 extend=""
+status=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --tasks) tasks=$2; shift 2 ;;
@@ -41,7 +43,8 @@ while [ $# -gt 0 ]; do
     --no-recipe) recipe=0; shift ;;
     --replot) replot=1; shift ;;
     --extend) extend=$2; shift 2 ;;
-    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --status) status=1; shift ;;
+    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -88,8 +91,8 @@ if [ -n "$out" ] && [ -f "$out/grid.txt" ]; then
   fi
   tasks=$g_tasks methods=$g_methods seeds=$g_seeds updates=$g_updates recipe=$g_recipe
   mapfile -t sets < <(printf '%s' "$g_sets" | sed '/^$/d')
-elif [ "$replot" = 1 ]; then
-  echo "grid.sh: --replot needs --out with an existing grid (its grid.txt)" >&2; exit 2
+elif [ "$replot" = 1 ] || [ "$status" = 1 ]; then
+  echo "grid.sh: --replot and --status need --out with an existing grid (its grid.txt)" >&2; exit 2
 else
   tasks=${tasks:-a1_beam} methods=${methods:-masa sa} seeds=${seeds:-0}
   out=${out:-experiments/results/grid_$(date +%Y%m%d_%H%M%S)}
@@ -100,6 +103,66 @@ else
   } > "$out/grid.txt"
 fi
 out=$(cd "$out" && pwd)
+
+# --status: every run's updates against its target, and the grid's ETA from each method's recent
+# seconds per update (the mean over its runs of the median of their last 50 updates) at the grid's
+# slots (those of the running grid, else one per core). Reads only; a running grid goes on.
+if [ "$status" = 1 ]; then
+  running=0
+  ( flock -n 9 ) 9> "$out/.grid.lock" || running=1
+  slots_now=$( [ "$running" = 1 ] && [ -f "$out/.slots" ] && wc -l < "$out/.slots" || nproc)
+  echo "grid $out: $tasks / $methods / seeds $seeds, ${updates:-the recipe max_epochs} updates a run;" \
+       "$( [ "$running" = 1 ] && echo "running, $slots_now at a time" || echo "not running")"
+  for t in $tasks; do for m in $methods; do for sd in $seeds; do
+    dir="$out/$t/${m}_s$sd" target=$updates
+    [ -n "$target" ] || target=$(sed -n 's/^ *max_epochs: *\([0-9]*\).*/\1/p' "$dir/config.yaml" 2>/dev/null | head -1)
+    [ -n "$target" ] || target=$(sed -n 's/^ *max_epochs: *\([0-9]*\).*/\1/p' "configs/recipes/$t.yaml" 2>/dev/null | head -1)
+    state=waiting
+    if [ -f "$dir/done" ]; then state=done
+    elif [ -f "$dir/metrics.csv" ]; then
+      state=stopped
+      [ "$running" = 1 ] && [ $(( $(date +%s) - $(stat -c %Y "$dir/metrics.csv") )) -lt 300 ] && state=running
+    fi
+    echo "$t $m $sd ${target:-0} $state $dir/metrics.csv"
+  done; done; done | awk -v slots="$slots_now" '
+    { run[NR] = $0; t[NR] = $1; m[NR] = $2; s[NR] = $3; target[NR] = $4; state[NR] = $5; rows = 0; spu = ""
+      if ($5 != "waiting") {
+        n = 0
+        while ((getline line < $6) > 0) { if (n > 0) { split(line, f, ","); w[n] = f[4] } n++ }
+        close($6); rows = n - 1
+        k = rows > 50 ? 50 : rows - 1
+        if (k > 0) {  # the median of the last k updates: a pause (a session break, SIGSTOP) does not count
+          for (j = 1; j <= k; j++) {
+            d = w[rows - j + 1] - w[rows - j]
+            for (q = j - 1; q >= 1 && dd[q] > d; q--) dd[q + 1] = dd[q]
+            dd[q + 1] = d
+          }
+          spu = k % 2 ? dd[(k + 1) / 2] : (dd[k / 2] + dd[k / 2 + 1]) / 2
+          sum[$1 " " $2] += spu; cnt[$1 " " $2]++; all += spu; nall++
+        }
+      }
+      done_rows[NR] = rows; speed[NR] = spu; count[$5]++ }
+    END {
+      total = 0; left = 0; eta = 0
+      for (i = 1; i <= NR; i++) {
+        key = t[i] " " m[i]
+        per = cnt[key] > 0 ? sum[key] / cnt[key] : (nall > 0 ? all / nall : 0)
+        remaining = target[i] - done_rows[i]; if (remaining < 0) remaining = 0
+        total += target[i]; left += remaining; eta += remaining * per
+        printf "  %-20s %-6s seed %-3s %7d/%-7d %-8s %s\n", t[i], m[i], s[i], done_rows[i], target[i], state[i],
+               speed[i] == "" ? "" : sprintf("%.2f s/update", speed[i])
+      }
+      pct = total > 0 ? 100 * (total - left) / total : 0
+      h = eta / (slots > 0 ? slots : 1) / 3600
+      printf "%d done, %d running, %d stopped, %d waiting; %d of %d updates (%.0f%%); ", count["done"], count["running"],
+             count["stopped"], count["waiting"], total - left, total, pct
+      if (nall > 0) printf "ETA %d:%02d h at %d run%s at a time\n", int(h), int((h - int(h)) * 60 + 0.5), slots,
+                           slots == 1 ? "" : "s"
+      else printf "no run has measured its speed yet\n"
+    }'
+  exit 0
+fi
+
 # One grid per directory: a second one (a command given twice) would start the same runs afresh
 # over the first's. The lock is held until this script exits.
 if [ -z "$extend" ]; then

@@ -2,7 +2,7 @@
 # experiments/grid.sh as a user meets it: a grid of 2 tiny runs killed during its first run goes
 # on from that run's checkpoint when the same command is given again (not from the start), finishes
 # both, does not redo finished runs on a third call, draws the comparison (masa_compare), and goes
-# on to more updates with --extend.
+# on to more updates with --extend; --status shows where each run stands.
 #   tests/experiments/grid_resume.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$(cd "$1" && pwd) work=$2
@@ -34,6 +34,12 @@ wait "$pid" && fail "the killed grid exited 0" || true
 rows_at_kill=$(($(wc -l < "$csv") - 1))
 [ "$rows_at_kill" -lt 150 ] || fail "masa's run finished before the kill (make the runs longer)"
 echo "killed at $rows_at_kill of 150 updates"
+# --status: the killed run where it stopped, the other waiting, and an ETA from the measured speed.
+"$src/experiments/grid.sh" --status --out grid > status.out 2>&1 || fail "--status failed: $(cat status.out)"
+grep -Eq "a1_beam +masa +seed 0 +$rows_at_kill/150 +stopped +[0-9.]+ s/update" status.out || fail "--status: $(cat status.out)"
+grep -Eq "a1_beam +sa +seed 0 +0/150 +waiting" status.out || fail "--status does not show sa waiting: $(cat status.out)"
+grep -Eq "^0 done, 0 running, 1 stopped, 1 waiting; $rows_at_kill of 300 updates .*ETA [0-9]+:[0-9]{2} h" status.out || \
+  fail "--status summary: $(cat status.out)"
 
 # 2. The same command again: masa goes on from its checkpoint, sa runs, the comparison is drawn.
 "${grid[@]}" > grid2.out 2>&1 || fail "the resumed grid failed"
