@@ -71,6 +71,24 @@ TEST(MlpAllocation, NoneInForwardBackwardAdamAtTheSameOrSmallerBatch) {
   expectNoAllocationInTrainingStep<double>(shape, 16, 1);
 }
 
+// The robot runner's path: frozen parameters, 1-4 columns from packs made on each count's first
+// call; after those, inference allocates nothing.
+TEST(MlpAllocation, NoneInFrozenInferenceAfterTheFirstCallOfEachColumnCount) {
+  if (!test::allocationCountingEnabled()) GTEST_SKIP() << "malloc is owned by a sanitizer";
+  ParameterSet<float> params;
+  Mlp<float> mlp(params, "net", MlpShape{74, {400, 200, 100}, 21, Activation::kElu, Activation::kIdentity});
+  params.finalize();
+  Rng rng(9);
+  mlp.initialize(rng);
+  params.freeze();
+  const Mat<float> x = Mat<float>::Random(74, 4);
+  for (int n = 1; n <= 4; ++n) mlp.infer(x.leftCols(n));
+  const long before = allocations();
+  for (int rep = 0; rep < 3; ++rep)
+    for (int n = 1; n <= 4; ++n) escape(mlp.infer(x.leftCols(n)).data());
+  EXPECT_EQ(allocations() - before, 0);
+}
+
 TEST(MlpAllocation, NoneForTheHumanoidPolicyFromActorToMinibatchSizes) {
   if (!test::allocationCountingEnabled()) GTEST_SKIP() << "malloc is owned by a sanitizer";
   MlpShape shape;
