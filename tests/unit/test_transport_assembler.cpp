@@ -234,7 +234,9 @@ TEST(RolloutAssembler, ARestartedActorIsANewIncarnationAndIsAcceptedAtOnce) {
       EXPECT_TRUE(v) << "rollout " << k << " of the restarted actor: " << dropReasonName(v.reason);
       ++sent;
     }
-    if (k == 0) EXPECT_EQ(assembler.actorTally(0).numberings, 1) << "one rollout alone may be a replay or a forgery";
+    if (k == 0) {
+      EXPECT_EQ(assembler.actorTally(0).numberings, 1) << "one rollout alone may be a replay or a forgery";
+    }
   }
   EXPECT_EQ(assembler.stats()[DropReason::kAccepted], sent);
   EXPECT_EQ(assembler.stats().dropped(), 0) << "nothing dropped, nothing counted lost";
