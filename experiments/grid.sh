@@ -229,6 +229,8 @@ if [ "$replot" = 0 ]; then
     reached=$(sed -n 's/^masa_train: \([0-9][0-9]*\) updates, [0-9]* env steps; .*/\1/p' "$log" | tail -1)
     if [ "$rc" = 0 ] && [ -n "$target" ] && [ "$reached" = "$target" ]; then
       touch "$dir/done"; echo "grid.sh: done $t $m seed $s ($reached updates, $host)"
+      # The grid's progress and ETA after each finished run (the summary line of --status).
+      echo "grid.sh: $(bash "$repo/experiments/grid.sh" --status --out "$out" 2>/dev/null | tail -n 1)"
     elif [ "$rc" = 0 ]; then
       echo "grid.sh: stopped $t $m seed $s at ${reached:-?} of ${target:-?} updates (a rerun resumes it)"
     else

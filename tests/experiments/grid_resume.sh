@@ -44,6 +44,8 @@ grep -Eq "^0 done, 0 running, 1 stopped, 1 waiting; $rows_at_kill of 300 updates
 # 2. The same command again: masa goes on from its checkpoint, sa runs, the comparison is drawn.
 "${grid[@]}" > grid2.out 2>&1 || fail "the resumed grid failed"
 grep -q "0 already done" grid2.out || fail "the resumed grid thought a run was done"
+grep -Eq "^grid.sh: 1 done, [01] running, .* of 300 updates \([0-9]+%\); ETA [0-9]+:[0-9]{2} h" grid2.out || \
+  fail "no progress line after the first finished run: $(cat grid2.out)"
 grep -q -- "--resume .*masa_s0" grid/a1_beam/masa_s0.log || fail "masa's run was not resumed from its checkpoint"
 [ -f grid/a1_beam/masa_s0/done ] && [ -f grid/a1_beam/sa_s0/done ] || fail "a run is not marked done"
 [ "$(($(wc -l < "$csv") - 1))" -eq 150 ] || fail "masa's metrics.csv has $(($(wc -l < "$csv") - 1)) rows, not 150"
