@@ -2,6 +2,8 @@
 //   p -= (lr / (1 - b1^t)) * m / (sqrt(v) / sqrt(1 - b2^t) + eps).
 #include "common/nn/adam.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +12,7 @@
 #include <ostream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "common/core/check.hpp"
 
@@ -55,17 +58,28 @@ void Adam<S>::step() {
   const S step_size = static_cast<S>(config_.lr / bc1);
   const S inv_sqrt_bc2 = static_cast<S>(1.0 / std::sqrt(bc2));
   // One pass in L1-sized blocks instead of three passes over the whole vectors; the arithmetic
-  // (and so every bit of the result) is that of the three whole-vector expressions.
+  // (and so every bit of the result) is that of the three whole-vector expressions. The update is
+  // elementwise, so the blocks can go to any thread: on two threads a serial Adam was 4% of a
+  // 1024-column policy step.
   constexpr Eigen::Index kBlock = 2048;
+  constexpr Eigen::Index kMinBlocksPerThread = 8;
   const Eigen::Index n = m_.size();
-  for (Eigen::Index i = 0; i < n; i += kBlock) {
-    const Eigen::Index len = std::min(kBlock, n - i);
-    auto g = params_->grads().segment(begin_ + i, len).array();
+  const Eigen::Index blocks = (n + kBlock - 1) / kBlock;
+  const int threads = omp_in_parallel() ? 1
+                                        : static_cast<int>(std::clamp<Eigen::Index>(
+                                              blocks / kMinBlocksPerThread, 1, std::max(1, omp_get_max_threads())));
+  const S eps = config_.eps;
+  const Vec<S>& grads = std::as_const(*params_).grads();
+  Vec<S>& values = params_->values();  // (throws on frozen parameters, before any thread starts)
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+  for (Eigen::Index block = 0; block < blocks; ++block) {
+    const Eigen::Index i = block * kBlock, len = std::min(kBlock, n - i);
+    auto g = grads.segment(begin_ + i, len).array();
     auto m = m_.segment(i, len).array();
     auto v = v_.segment(i, len).array();
     m = b1 * m + (S(1) - b1) * g;
     v = b2 * v + (S(1) - b2) * g.square();
-    params_->values().segment(begin_ + i, len).array() -= step_size * m / (v.sqrt() * inv_sqrt_bc2 + config_.eps);
+    values.segment(begin_ + i, len).array() -= step_size * m / (v.sqrt() * inv_sqrt_bc2 + eps);
   }
 }
 

@@ -68,8 +68,18 @@ Index packedSize(int rows, int depth) {
 }
 
 void pack(const float* w, Index ld, bool transpose, int rows, int depth, float* packed) {
+  pack(w, ld, transpose, rows, depth, packed, 0, 1);
+}
+
+void pack(const float* w, Index ld, bool transpose, int rows, int depth, float* packed, int part, int parts) {
+  MASA_CHECK(parts >= 1 && part >= 0 && part < parts, "dense::pack: part " << part << " of " << parts);
+  int panel = -1;
   forEachPanel(rows, [&](int r0, int vectors) {
     const int width = vectors * kLanes;
+    if (++panel % parts != part) {
+      packed += static_cast<Index>(width) * depth;
+      return;
+    }
     const int valid = std::min(width, rows - r0);
     for (int r = 0; r < width; ++r) {
       float* dst = packed + r;

@@ -38,6 +38,9 @@ Index packedSize(int rows, int depth);
 // op(W) = W when !transpose (W is rows x depth), W^T when transpose (W is depth x rows).
 // `packed` holds packedSize(rows, depth) floats.
 void pack(const float* w, Index ld, bool transpose, int rows, int depth, float* packed);
+// The same layout, written only for panels p with p % parts == part: `parts` threads, each with
+// its own part, write together exactly what one pack() writes.
+void pack(const float* w, Index ld, bool transpose, int rows, int depth, float* packed, int part, int parts);
 
 // y = f(W x + bias) for n columns. W: rows x depth (ldw), read in place; x: depth x n (ldx);
 // y: rows x n (ldy); bias: rows values or null. Writes only the rows < `rows` of y.

@@ -335,10 +335,15 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
     const int B = batch_;
     const int L = numLayers();
     const S* values = std::as_const(*params_).values().data();
-    for (int k = dx ? 0 : 1; k < L; ++k) {
-      const Layer& l = layers_[k];
-      dense::pack(values + l.w_offset, l.out, true, l.in, l.out, packed_t_.data() + packed_t_offset_[k]);
-    }
+    // W^T of every layer whose input gradient is needed, packed by `part` of `parts` threads.
+    auto pack_transposes = [&](int part, int parts) {
+      for (int k = dx ? 0 : 1; k < L; ++k) {
+        const Layer& l = layers_[k];
+        // Rotated per layer so that the odd panels of each layer do not all fall to one thread.
+        dense::pack(values + l.w_offset, l.out, true, l.in, l.out, packed_t_.data() + packed_t_offset_[k],
+                    (part + k) % parts, parts);
+      }
+    };
     // Columns [j0, j0 + n) through every layer, on thread t's scratch, into gradient `grad`.
     auto chunk = [&](int j0, int n, int t, S* grad) {
       Mat<S>& scratch = scratch_[t];
@@ -392,6 +397,7 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
     const int blocks = (B + kBlock - 1) / kBlock;
     const int threads = std::min({blocks, threadsFor(B, kMinBackwardColumnsPerThread), static_cast<int>(scratch_.size())});
     if (threads <= 1) {
+      pack_transposes(0, 1);
       blocks_in_chunks(0, blocks, 0, grads);
       return;
     }
@@ -402,6 +408,10 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
       const int t = omp_get_thread_num(), nt = omp_get_num_threads();
       S* grad = t == 0 ? grads : grad_partial_[t - 1].data();
       if (t > 0) grad_partial_[t - 1].setZero();
+      // The packing is a serial pass over every weight otherwise (5% of a 1024-column step on two
+      // threads); each panel is written by one thread, so the packed bytes are the same.
+      pack_transposes(t, nt);
+#pragma omp barrier
       // Static: which blocks a thread sums must not depend on timing, or the float sums (and so
       // the whole run) would differ between runs of the same seed. Contiguous runs of blocks,
       // the first (blocks % nt) threads one more (OpenMP's static schedule, as before chunks

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <sstream>
@@ -62,6 +63,37 @@ TEST(Adam, RangeStepsOnlyItsValuesLikeAWholeSetAdamOverThem) {
   EXPECT_EQ(p.values()(4), -1.0);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(p.values()(1 + i), alone.values()(i)) << "index " << i + 1;
   EXPECT_THROW(Adam<double>(p, AdamConfig<double>{}, 2, 6), std::exception);
+}
+
+// The blocks of a large set go to several threads: every block must be updated exactly once, so
+// the values after some steps are those of one thread, bit for bit (a range that does not start
+// at 0 and a last block that is partial included).
+TEST(Adam, SeveralThreadsGiveTheBitsOfOneThread) {
+  const int n = 100003, begin = 5, end = n - 7;
+  auto run = [&](int threads) {
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    ParameterSet<float> p;
+    p.reserve("x", n);
+    p.finalize();
+    for (int i = 0; i < n; ++i) p.values()(i) = std::sin(0.37f * static_cast<float>(i));
+    Adam<float> adam(p, AdamConfig<float>{}, begin, end);
+    for (int t = 1; t <= 3; ++t) {
+      for (int i = 0; i < n; ++i) p.grads()(i) = std::cos(0.11f * static_cast<float>(i * t));
+      adam.step();
+    }
+    omp_set_num_threads(saved);
+    return Vec<float>(p.values());
+  };
+  const Vec<float> one = run(1);
+  for (int threads : {2, 3}) {
+    const Vec<float> several = run(threads);
+    int differing = 0;
+    for (int i = 0; i < n; ++i) differing += several(i) != one(i);
+    EXPECT_EQ(differing, 0) << threads << " threads";
+  }
+  EXPECT_EQ(one(0), std::sin(0.f));  // outside the range: untouched
+  EXPECT_NE(one(begin), std::sin(0.37f * begin));
 }
 
 TEST(Adam, LearningRateChangeBetweenStepsTakesEffect) {

@@ -208,6 +208,26 @@ TEST(DenseKernelsPack, PanelsHoldRowsOfOpWZeroPadded) {
   }
 }
 
+// Threads that pack a part each (the fused backward's W^T) write together exactly the bytes of
+// one pack: every panel once, padding included, at 1 to 4 parts and shapes of 1 to 9 panels.
+TEST(DenseKernelsPack, PartsWriteTogetherWhatOnePackWrites) {
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  for (const auto& [rows, depth] : {std::pair{7, 5}, std::pair{70, 3}, std::pair{400, 74}, std::pair{100, 200}}) {
+    const Mat<float> w = Mat<float>::Random(depth, rows);  // transposed: W^T is rows x depth
+    std::vector<float> whole(dense::packedSize(rows, depth), -1.f);
+    dense::pack(w.data(), depth, true, rows, depth, whole.data());
+    for (int parts = 1; parts <= 4; ++parts) {
+      std::vector<float> together(whole.size(), -1.f);
+      for (int part = parts - 1; part >= 0; --part)
+        dense::pack(w.data(), depth, true, rows, depth, together.data(), part, parts);
+      EXPECT_EQ(together, whole) << rows << " x " << depth << " in " << parts << " parts";
+    }
+  }
+  float unused[16];
+  EXPECT_THROW(dense::pack(unused, 1, true, 1, 1, unused, 2, 2), std::exception);
+  EXPECT_THROW(dense::pack(unused, 1, true, 1, 1, unused, 0, 0), std::exception);
+}
+
 // The fused float engine against the double generic one, same parameters: outputs, parameter
 // gradients and input gradients, at batches that use one thread, several, and partial chunks.
 void expectFusedMatchesGeneric(const MlpShape& shape, int batch, int threads) {
