@@ -2,7 +2,8 @@
 # experiments/grid.sh as a user meets it: a grid of 2 tiny runs killed during its first run goes
 # on from that run's checkpoint when the same command is given again (not from the start), finishes
 # both, does not redo finished runs on a third call, draws the comparison (masa_compare), and goes
-# on to more updates with --extend; --status shows where each run stands.
+# on to more updates with --extend; --status shows where each run stands; record_grid.sh copies it
+# for the record.
 #   tests/experiments/grid_resume.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$(cd "$1" && pwd) work=$2
@@ -88,6 +89,36 @@ for m in masa sa; do
 done
 [ -s grid/verdict.md ] || fail "the extended grid did not redo the comparison"
 
+# 3c. record_grid.sh: the grid as experiments/results/ keeps it (redrawn, no checkpoints, policies
+# or per-run PNGs, with RECORD.txt); refused over an existing folder, while a grid runs, for a
+# folder that is no grid, and over the grid itself.
+rm -f grid/verdict.md
+"$src/experiments/record_grid.sh" --out grid --to rec > rec.out 2>&1 || fail "record_grid.sh failed: $(cat rec.out)"
+for f in verdict.md grid.txt status.txt RECORD.txt a1_beam/runs.csv a1_beam/masa_s0/config.yaml \
+         a1_beam/masa_s0/metrics.csv a1_beam/sa_s0/metrics.csv a1_beam/masa_s0.log; do
+  [ -s "rec/$f" ] || fail "the record has no $f"
+done
+[ -s grid/verdict.md ] || fail "record_grid.sh did not redraw the comparison first"
+left_in=$(find rec -name checkpoint.bin -o -name policy.bin -o -name learning_curve.png -o -name '.grid.lock')
+[ -z "$left_in" ] || fail "the record keeps what it should leave out: $left_in"
+cmp -s rec/a1_beam/masa_s0/metrics.csv grid/a1_beam/masa_s0/metrics.csv || fail "the recorded metrics differ"
+grep -Eq "^checkout: [0-9a-f]{40}" rec/RECORD.txt && grep -q "^grid: tasks=a1_beam methods=masa sa" rec/RECORD.txt || \
+  fail "RECORD.txt: $(cat rec/RECORD.txt)"
+grep -q "^2 done, 0 running" rec/status.txt || fail "the recorded status: $(cat rec/status.txt)"
+"$src/experiments/record_grid.sh" --out grid --to rec > rec2.out 2>&1 && fail "recording over an existing folder was accepted"
+grep -q "rec exists (--force replaces it)" rec2.out || fail "no reason given: $(cat rec2.out)"
+"$src/experiments/record_grid.sh" --out grid --to rec --force --policies > rec3.out 2>&1 || fail "--force failed: $(cat rec3.out)"
+[ -s rec/a1_beam/masa_s0/policy.bin ] || fail "--policies kept no policy"
+exec 8> grid/.grid.lock
+flock -n 8 || fail "could not take the grid's lock"
+"$src/experiments/record_grid.sh" --out grid --to rec_running > rec4.out 2>&1 && fail "recording a running grid was accepted"
+grep -q "a grid is running in" rec4.out && [ ! -e rec_running ] || fail "no reason given: $(cat rec4.out)"
+exec 8>&-
+"$src/experiments/record_grid.sh" --out rec/a1_beam --to rec5 > rec5.out 2>&1 && fail "a folder without grid.txt was accepted"
+grep -q "is not a grid" rec5.out || fail "no reason given: $(cat rec5.out)"
+"$src/experiments/record_grid.sh" --out grid --to . --force > rec6.out 2>&1 && fail "recording over the grid's parent was accepted"
+grep -q "would hold or replace the grid itself" rec6.out && [ -d grid/a1_beam ] || fail "no reason given: $(cat rec6.out)"
+
 # 4. Over a hosts file: every run goes through MASA_SSH and its directory through MASA_RSYNC (here
 # stand-ins that run on this machine and log what they were asked to do).
 cat > fake_ssh.sh <<'SH'
@@ -106,4 +137,4 @@ grep -q "2 at a time" grid6.out || fail "the hosts file's 2 slots were not used"
 [ "$(grep -c '^ssh far-host .*masa_train' remote.log)" -eq 2 ] || fail "the runs did not go through ssh to far-host"
 grep -q "^rsync -a far-host:$PWD/remote/a1_beam/masa_s0/ $PWD/remote/a1_beam/masa_s0/" remote.log || \
   fail "masa's run directory was not copied back"
-echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, hosts file used"
+echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, recorded, hosts file used"

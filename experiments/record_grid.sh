@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Copies a grid (experiments/grid.sh) into a results folder for the record, the way every folder
+# under experiments/results/ is kept: the figures and the verdict redrawn from the metrics being
+# recorded, every run's config.yaml, metrics.csv and log, the grid's definition and status, and
+# RECORD.txt (when, from which commit, on what machine); no checkpoints, policies or per-run PNGs,
+# which the repository does not need (--policies keeps the policies).
+#
+#   experiments/record_grid.sh --out runs/grid_ant --to experiments/results/ant_acrobatic_grid_2026-12-05
+#
+# --force replaces an existing --to folder. Refused while a grid runs in --out (its metrics would
+# move under the copy). MASA_BUILD_DIR chooses the build whose masa_compare redraws (default build).
+set -euo pipefail
+
+usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
+out="" to="" force=0 policies=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --out) out=${2:?--out needs a directory}; shift 2 ;;
+    --to) to=${2:?--to needs a directory}; shift 2 ;;
+    --force) force=1; shift ;;
+    --policies) policies=1; shift ;;
+    -h|--help) usage ;;
+    *) echo "record_grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+[ -n "$out" ] && [ -n "$to" ] || { echo "record_grid.sh: give --out GRID_DIR and --to RESULTS_DIR" >&2; exit 2; }
+[ -f "$out/grid.txt" ] || { echo "record_grid.sh: $out is not a grid (no grid.txt)" >&2; exit 2; }
+here=$(cd "$(dirname "$0")" && pwd)
+out=$(cd "$out" && pwd)
+case "$out/" in "$(realpath -m "$to")"/*) echo "record_grid.sh: --to $to would hold or replace the grid itself" >&2; exit 2 ;; esac
+
+# Not while a grid runs there: its metrics would move under the copy. grid.sh --replot takes the
+# same lock, so a grid started after this check makes the redraw fail rather than the copy mix.
+( flock -n 9 ) 9> "$out/.grid.lock" || { echo "record_grid.sh: a grid is running in $out; record it once it has stopped" >&2; exit 3; }
+if [ -e "$to" ]; then
+  [ "$force" = 1 ] || { echo "record_grid.sh: $to exists (--force replaces it)" >&2; exit 2; }
+  rm -rf "$to"
+fi
+# The figures and the verdict of exactly these metrics.
+"$here/grid.sh" --replot --out "$out" > /dev/null || { echo "record_grid.sh: redrawing the comparison failed" >&2; exit 1; }
+
+mkdir -p "$to"
+excludes=(--exclude=checkpoint.bin --exclude=learning_curve.png --exclude=learning_curve.log
+          --exclude=.grid.lock --exclude=.queue --exclude=.queue.lock --exclude=.slots)
+[ "$policies" = 1 ] || excludes+=(--exclude=policy.bin)
+"$here/grid.sh" --status --out "$out" > "$to/status.txt"
+tar -C "$out" "${excludes[@]}" -cf - . | tar -C "$to" -xf -
+
+repo=$(cd "$here/.." && pwd)
+commit=$(git -C "$repo" rev-parse HEAD 2> /dev/null || echo unknown)
+dirty=$(git -C "$repo" status --porcelain --untracked-files=no 2> /dev/null | head -1)
+{
+  echo "recorded: $(date -u +%Y-%m-%dT%H:%M:%SZ) from $out"
+  echo "checkout: $commit${dirty:+ (with uncommitted changes)}"
+  echo "machine: $(hostname), $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
+  echo "build: ${MASA_BUILD_DIR:-build} (each run's log starts with the exact command it ran)"
+  echo "grid: $(grep -v '^#' "$out/grid.txt" | tr '\n' ' ')"
+  grep '^#' "$out/grid.txt" || true
+  echo "status: $(tail -n 1 "$to/status.txt")"
+} > "$to/RECORD.txt"
+echo "record_grid.sh: $out recorded in $to ($(du -sh "$to" | cut -f1)); see $to/RECORD.txt"
