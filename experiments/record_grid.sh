@@ -48,7 +48,8 @@ tar -C "$out" "${excludes[@]}" -cf - . | tar -C "$to" -xf -
 
 repo=$(cd "$here/.." && pwd)
 commit=$(git -C "$repo" rev-parse HEAD 2> /dev/null || echo unknown)
-dirty=$(git -C "$repo" status --porcelain --untracked-files=no 2> /dev/null | head -1)
+# (the folder being written does not count: replacing a record is not a change of the code)
+dirty=$(git -C "$repo" status --porcelain --untracked-files=no -- . ":(exclude)$(realpath -m "$to")" 2> /dev/null | head -1)
 {
   echo "recorded: $(date -u +%Y-%m-%dT%H:%M:%SZ) from $out"
   echo "checkout: $commit${dirty:+ (with uncommitted changes)}"
