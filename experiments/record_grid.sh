@@ -2,8 +2,8 @@
 # Copies a grid (experiments/grid.sh) into a results folder for the record, the way every folder
 # under experiments/results/ is kept: the figures and the verdict redrawn from the metrics being
 # recorded, every run's config.yaml, metrics.csv and log, the grid's definition and status, and
-# RECORD.txt (when, from which commit, on what machine); no checkpoints, policies or per-run PNGs,
-# which the repository does not need (--policies keeps the policies).
+# RECORD.txt (when, from which commit, on what machine, where each run was resumed); no
+# checkpoints, policies or per-run PNGs, which the repository does not need (--policies keeps them).
 #
 #   experiments/record_grid.sh --out runs/grid_ant --to experiments/results/ant_acrobatic_grid_2026-12-05
 #
@@ -49,14 +49,26 @@ tar -C "$out" "${excludes[@]}" -cf - . | tar -C "$to" -xf -
 repo=$(cd "$here/.." && pwd)
 commit=$(git -C "$repo" rev-parse HEAD 2> /dev/null || echo unknown)
 # (the folder being written does not count: replacing a record is not a change of the code)
-dirty=$(git -C "$repo" status --porcelain --untracked-files=no -- . ":(exclude)$(realpath -m "$to")" 2> /dev/null | head -1)
+to_abs=$(realpath -m "$to") exclude=()
+case "$to_abs/" in "$repo"/*) exclude=(":(exclude)$to_abs") ;; esac
+dirty=$(git -C "$repo" status --porcelain --untracked-files=no -- . "${exclude[@]}" 2> /dev/null | head -1 || true)
 {
   echo "recorded: $(date -u +%Y-%m-%dT%H:%M:%SZ) from $out"
   echo "checkout: $commit${dirty:+ (with uncommitted changes)}"
-  echo "machine: $(hostname), $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
+  echo "machine: $(hostname), $(nproc --all) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
   echo "build: ${MASA_BUILD_DIR:-build} (each run's log starts with the exact command it ran)"
   echo "grid: $(grep -v '^#' "$out/grid.txt" | tr '\n' ' ')"
   grep '^#' "$out/grid.txt" || true
   echo "status: $(tail -n 1 "$to/status.txt")"
+  # A resume restarts the run's environments from a reset (the checkpoint holds the learner only),
+  # which shows in its curves: where each run went on, from its log ("?" after a hard stop).
+  echo "resumes (update at which a run went on from its checkpoint, environments reset there):"
+  for log in "$out"/*/*_s*.log; do
+    [ -f "$log" ] || continue
+    points=$(awk '/^masa_train: [0-9]+ updates,/ { last = $2 }
+                  /^# .* --resume / { printf "%s ", last == "" ? "?" : last; last = "" }' "$log")
+    run=${log#"$out"/}
+    [ -z "$points" ] || echo "  ${run%.log}: $points"
+  done
 } > "$to/RECORD.txt"
 echo "record_grid.sh: $out recorded in $to ($(du -sh "$to" | cut -f1)); see $to/RECORD.txt"

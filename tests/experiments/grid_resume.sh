@@ -105,6 +105,9 @@ cmp -s rec/a1_beam/masa_s0/metrics.csv grid/a1_beam/masa_s0/metrics.csv || fail 
 grep -Eq "^checkout: [0-9a-f]{40}" rec/RECORD.txt && grep -q "^grid: tasks=a1_beam methods=masa sa" rec/RECORD.txt || \
   fail "RECORD.txt: $(cat rec/RECORD.txt)"
 grep -q "^2 done, 0 running" rec/status.txt || fail "the recorded status: $(cat rec/status.txt)"
+# Where each run was resumed: masa at the kill and at the extension, sa at the extension only.
+grep -Eq "^  a1_beam/masa_s0: $rows_at_kill 150 \$" rec/RECORD.txt && grep -Eq "^  a1_beam/sa_s0: 150 \$" rec/RECORD.txt || \
+  fail "RECORD.txt does not list the resumes: $(cat rec/RECORD.txt)"
 "$src/experiments/record_grid.sh" --out grid --to rec > rec2.out 2>&1 && fail "recording over an existing folder was accepted"
 grep -q "rec exists (--force replaces it)" rec2.out || fail "no reason given: $(cat rec2.out)"
 "$src/experiments/record_grid.sh" --out grid --to rec --force --policies > rec3.out 2>&1 || fail "--force failed: $(cat rec3.out)"
