@@ -61,12 +61,18 @@ dirty=$(git -C "$repo" status --porcelain --untracked-files=no -- . "${exclude[@
   grep '^#' "$out/grid.txt" || true
   echo "status: $(tail -n 1 "$to/status.txt")"
   # A resume restarts the run's environments from a reset (the checkpoint holds the learner only),
-  # which shows in its curves: where each run went on, from its log ("?" after a hard stop).
+  # which shows in its curves: where each run went on, from its log. masa_train says it ("resumed
+  # at update K"); before it did, the update where the previous process stopped stands in ("?"
+  # after a hard stop, which left no such line).
   echo "resumes (update at which a run went on from its checkpoint, environments reset there):"
   for log in "$out"/*/*_s*.log; do
     [ -f "$log" ] || continue
-    points=$(awk '/^masa_train: [0-9]+ updates,/ { last = $2 }
-                  /^# .* --resume / { printf "%s ", last == "" ? "?" : last; last = "" }' "$log")
+    points=$(awk 'function flush() { if (pending) printf "%s ", guess == "" ? "?" : guess; pending = 0 }
+                  /^# .* on .*: / { flush() }
+                  /^# .* --resume / { pending = 1; guess = last; last = "" }
+                  /^masa_train: resumed at update [0-9]+/ { if (pending) printf "%s ", $5; pending = 0 }
+                  /^masa_train: [0-9]+ updates,/ { last = $2 }
+                  END { flush() }' "$log")
     run=${log#"$out"/}
     [ -z "$points" ] || echo "  ${run%.log}: $points"
   done

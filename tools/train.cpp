@@ -81,6 +81,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "masa_train: %s / %s, %d envs x %d steps per update, %lld updates, run dir %s\n",
                  rc.task.c_str(), masa::model::methodName(rc.method).c_str(), rc.ppo.num_envs, rc.ppo.horizon,
                  static_cast<long long>(updates), learner.runDir().c_str());
+    // The checkpoint holds the learner, not the environments: say where the curves will show it.
+    if (lo.resume)
+      std::fprintf(stderr, "masa_train: resumed at update %lld (%lld env steps); the environments start from a reset here\n",
+                   static_cast<long long>(learner.updates()), static_cast<long long>(learner.envSteps()));
 
     while (!g_stop.load() && learner.updates() < updates) {
       if (!actor.pollParams(0)) {

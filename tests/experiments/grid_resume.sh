@@ -106,8 +106,14 @@ grep -Eq "^checkout: [0-9a-f]{40}" rec/RECORD.txt && grep -q "^grid: tasks=a1_be
   fail "RECORD.txt: $(cat rec/RECORD.txt)"
 grep -q "^2 done, 0 running" rec/status.txt || fail "the recorded status: $(cat rec/status.txt)"
 # Where each run was resumed: masa at the kill and at the extension, sa at the extension only.
+# masa_train says so in the log; logs of binaries from before that give the same from where each
+# process stopped.
+grep -q "^masa_train: resumed at update $rows_at_kill (" grid/a1_beam/masa_s0.log || fail "masa_train did not say where it resumed"
 grep -Eq "^  a1_beam/masa_s0: $rows_at_kill 150 \$" rec/RECORD.txt && grep -Eq "^  a1_beam/sa_s0: 150 \$" rec/RECORD.txt || \
   fail "RECORD.txt does not list the resumes: $(cat rec/RECORD.txt)"
+cp -a grid grid_old_logs && sed -i '/^masa_train: resumed at update/d' grid_old_logs/a1_beam/*.log
+"$src/experiments/record_grid.sh" --out grid_old_logs --to rec_old > rec_old.out 2>&1 || fail "record_grid.sh failed: $(cat rec_old.out)"
+grep -Eq "^  a1_beam/masa_s0: $rows_at_kill 150 \$" rec_old/RECORD.txt || fail "resumes from older logs: $(cat rec_old/RECORD.txt)"
 "$src/experiments/record_grid.sh" --out grid --to rec > rec2.out 2>&1 && fail "recording over an existing folder was accepted"
 grep -q "rec exists (--force replaces it)" rec2.out || fail "no reason given: $(cat rec2.out)"
 "$src/experiments/record_grid.sh" --out grid --to rec --force --policies > rec3.out 2>&1 || fail "--force failed: $(cat rec3.out)"
