@@ -104,7 +104,8 @@ else
 fi
 out=$(cd "$out" && pwd)
 
-# --status: every run's updates against its target, and the grid's ETA from each method's recent
+# --status: every run's updates against its target, its last evaluation return (the policy mean's,
+# runner.eval_every), and the grid's ETA from each method's recent
 # seconds per update (the mean over its runs of the median of their last 50 updates) at the grid's
 # slots (those of the running grid, else one per core). Reads only; a running grid goes on.
 if [ "$status" = 1 ]; then
@@ -128,7 +129,13 @@ if [ "$status" = 1 ]; then
     { run[NR] = $0; t[NR] = $1; m[NR] = $2; s[NR] = $3; target[NR] = $4; state[NR] = $5; rows = 0; spu = ""
       if ($5 != "waiting") {
         n = 0
-        while ((getline line < $6) > 0) { if (n > 0) { split(line, f, ","); w[n] = f[4] } n++ }
+        ev = ""; col = 0  # the last evaluation of the policy mean, from the eval_return column
+        while ((getline line < $6) > 0) {
+          nf = split(line, f, ",")
+          if (n == 0) { for (c = 1; c <= nf; c++) if (f[c] == "eval_return") col = c }
+          else { w[n] = f[4]; if (col > 0 && f[col] != "" && f[col] != "nan") ev = f[col] }
+          n++
+        }
         close($6); rows = n - 1
         k = rows > 50 ? 50 : rows - 1
         if (k > 0) {  # the median of the last k updates: a pause (a session break, SIGSTOP) does not count
@@ -141,7 +148,7 @@ if [ "$status" = 1 ]; then
           sum[$1 " " $2] += spu; cnt[$1 " " $2]++; all += spu; nall++
         }
       }
-      done_rows[NR] = rows; speed[NR] = spu; count[$5]++ }
+      done_rows[NR] = rows; speed[NR] = spu; last_eval[NR] = $5 == "waiting" ? "" : ev; count[$5]++ }
     END {
       total = 0; left = 0; eta = 0
       for (i = 1; i <= NR; i++) {
@@ -149,8 +156,9 @@ if [ "$status" = 1 ]; then
         per = cnt[key] > 0 ? sum[key] / cnt[key] : (nall > 0 ? all / nall : 0)
         remaining = target[i] - done_rows[i]; if (remaining < 0) remaining = 0
         total += target[i]; left += remaining; eta += remaining * per
-        printf "  %-20s %-6s seed %-3s %7d/%-7d %-8s %s\n", t[i], m[i], s[i], done_rows[i], target[i], state[i],
-               speed[i] == "" ? "" : sprintf("%.2f s/update", speed[i])
+        printf "  %-20s %-6s seed %-3s %7d/%-7d %-8s %-14s %s\n", t[i], m[i], s[i], done_rows[i], target[i], state[i],
+               speed[i] == "" ? "" : sprintf("%.2f s/update", speed[i]),
+               last_eval[i] == "" ? "" : sprintf("last eval %.1f", last_eval[i])
       }
       pct = total > 0 ? 100 * (total - left) / total : 0
       h = eta / (slots > 0 ? slots : 1) / 3600

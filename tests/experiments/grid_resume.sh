@@ -37,7 +37,12 @@ rows_at_kill=$(($(wc -l < "$csv") - 1))
 echo "killed at $rows_at_kill of 150 updates"
 # --status: the killed run where it stopped, the other waiting, and an ETA from the measured speed.
 "$src/experiments/grid.sh" --status --out grid > status.out 2>&1 || fail "--status failed: $(cat status.out)"
-grep -Eq "a1_beam +masa +seed 0 +$rows_at_kill/150 +stopped +[0-9.]+ s/update" status.out || fail "--status: $(cat status.out)"
+grep -Eq "a1_beam +masa +seed 0 +$rows_at_kill/150 +stopped +[0-9.]+ s/update +last eval -?[0-9.]+" status.out || \
+  fail "--status: $(cat status.out)"
+# The last evaluation shown is the last eval_return in the run's metrics.
+last_eval=$(awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) if ($c == "eval_return") col = c; next }
+                     $col != "" && $col != "nan" { v = $col } END { printf "%.1f", v }' "$csv")
+grep -Eq "a1_beam +masa +seed 0 .* last eval $last_eval\$" status.out || fail "--status does not show the last evaluation $last_eval: $(cat status.out)"
 grep -Eq "a1_beam +sa +seed 0 +0/150 +waiting" status.out || fail "--status does not show sa waiting: $(cat status.out)"
 grep -Eq "^0 done, 0 running, 1 stopped, 1 waiting; $rows_at_kill of 300 updates .*ETA [0-9]+:[0-9]{2} h" status.out || \
   fail "--status summary: $(cat status.out)"
