@@ -37,10 +37,10 @@ using masa::nn::MlpShape;
 using masa::nn::ParameterSet;
 namespace dense = masa::nn::dense;
 
-constexpr int kObs = 74, kAct = 21;
-constexpr std::array<int, 5> kWidth{kObs, 400, 200, 100, kAct};
+constexpr int kObs = masa::bench::kHumanoidObs, kAct = masa::bench::kHumanoidAct;
+constexpr std::array<int, 5> kWidth{kObs, 400, 200, 100, kAct};  // the layers of kShape
 constexpr int kLayers = 4;
-const MlpShape kShape{kObs, {400, 200, 100}, kAct, Activation::kElu, Activation::kIdentity};
+const MlpShape kShape = masa::bench::humanoidNetwork(kAct);
 
 const bool kMachineDescribed = masa::bench::describeMachine();
 

@@ -28,16 +28,14 @@
 namespace {
 
 using masa::Mat;
-using masa::nn::Activation;
 using masa::nn::Adam;
 using masa::nn::Mlp;
 using masa::nn::MlpShape;
 using masa::nn::ParameterSet;
 
-constexpr int kObs = 74, kAct = 21;
-const std::vector<int> kHidden{400, 200, 100};
+constexpr int kObs = masa::bench::kHumanoidObs, kAct = masa::bench::kHumanoidAct;
 
-MlpShape shape(int output) { return MlpShape{kObs, kHidden, output, Activation::kElu, Activation::kIdentity}; }
+MlpShape shape(int output) { return masa::bench::humanoidNetwork(output); }
 
 const bool kMachineDescribed = masa::bench::describeMachine();
 
