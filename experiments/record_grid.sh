@@ -4,6 +4,8 @@
 # recorded, every run's config.yaml, metrics.csv and log, the grid's definition and status, and
 # RECORD.txt (when, from which commit, on what machine, where each run was resumed); no
 # checkpoints, policies or per-run PNGs, which the repository does not need (--policies keeps them).
+# --checkpoints keeps the checkpoints of the runs not yet finished, so that restore_grid.sh can bring
+# the grid back on another machine (or in a later session, whose machine is new) and go on.
 #
 #   experiments/record_grid.sh --out runs/grid_ant --to experiments/results/ant_acrobatic_grid_2026-12-05
 #
@@ -11,14 +13,15 @@
 # move under the copy). MASA_BUILD_DIR chooses the build whose masa_compare redraws (default build).
 set -euo pipefail
 
-usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
-out="" to="" force=0 policies=0
+usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
+out="" to="" force=0 policies=0 checkpoints=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out=${2:?--out needs a directory}; shift 2 ;;
     --to) to=${2:?--to needs a directory}; shift 2 ;;
     --force) force=1; shift ;;
     --policies) policies=1; shift ;;
+    --checkpoints) checkpoints=1; shift ;;
     -h|--help) usage ;;
     *) echo "record_grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -40,11 +43,14 @@ fi
 "$here/grid.sh" --replot --out "$out" > /dev/null || { echo "record_grid.sh: redrawing the comparison failed" >&2; exit 1; }
 
 mkdir -p "$to"
-excludes=(--exclude=checkpoint.bin --exclude=learning_curve.png --exclude=learning_curve.log
+excludes=(--exclude=learning_curve.png --exclude=learning_curve.log
           --exclude=.grid.lock --exclude=.queue --exclude=.queue.lock --exclude=.slots)
 [ "$policies" = 1 ] || excludes+=(--exclude=policy.bin)
+[ "$checkpoints" = 1 ] || excludes+=(--exclude=checkpoint.bin)
 "$here/grid.sh" --status --out "$out" > "$to/status.txt"
 tar -C "$out" "${excludes[@]}" -cf - . | tar -C "$to" -xf -
+# A finished run's checkpoint would only serve grid.sh --extend: not worth its megabytes here.
+find "$to" -mindepth 3 -maxdepth 3 -name done -execdir rm -f checkpoint.bin \;
 
 repo=$(cd "$here/.." && pwd)
 commit=$(git -C "$repo" rev-parse HEAD 2> /dev/null || echo unknown)
@@ -60,6 +66,10 @@ dirty=$(git -C "$repo" status --porcelain --untracked-files=no -- . "${exclude[@
   echo "grid: $(grep -v '^#' "$out/grid.txt" | tr '\n' ' ')"
   grep '^#' "$out/grid.txt" || true
   echo "status: $(tail -n 1 "$to/status.txt")"
+  if [ "$checkpoints" = 1 ]; then
+    echo "checkpoints: $(find "$to" -name checkpoint.bin | wc -l) unfinished runs keep theirs" \
+         "(experiments/restore_grid.sh --from $to --out DIR brings the grid back to go on)"
+  fi
   # A resume restarts the run's environments from a reset (the checkpoint holds the learner only),
   # which shows in its curves: where each run went on, from its log. masa_train says it ("resumed
   # at update K"); before it did, the update where the previous process stopped stands in ("?"

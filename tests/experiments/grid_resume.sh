@@ -3,7 +3,8 @@
 # on from that run's checkpoint when the same command is given again (not from the start), finishes
 # both, does not redo finished runs on a third call, draws the comparison (masa_compare), and goes
 # on to more updates with --extend; --status shows where each run stands; record_grid.sh copies it
-# for the record.
+# for the record, with the checkpoints of unfinished runs when asked, and restore_grid.sh brings
+# such a record back to go on (a grid that outlives its machine).
 #   tests/experiments/grid_resume.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$(cd "$1" && pwd) work=$2
@@ -46,6 +47,15 @@ grep -Eq "a1_beam +masa +seed 0 .* last eval $last_eval\$" status.out || fail "-
 grep -Eq "a1_beam +sa +seed 0 +0/150 +waiting" status.out || fail "--status does not show sa waiting: $(cat status.out)"
 grep -Eq "^0 done, 0 running, 1 stopped, 1 waiting; $rows_at_kill of 300 updates .*ETA [0-9]+:[0-9]{2} h" status.out || \
   fail "--status summary: $(cat status.out)"
+
+# 1b. The stopped grid recorded with its checkpoint (record_grid.sh --checkpoints, what a session
+# keeps when its machine goes), and without.
+"$src/experiments/record_grid.sh" --out grid --to rec_stopped --checkpoints > rec_stopped.out 2>&1 || \
+  fail "record_grid.sh --checkpoints failed: $(cat rec_stopped.out)"
+[ -s rec_stopped/a1_beam/masa_s0/checkpoint.bin ] || fail "--checkpoints did not keep the stopped run's checkpoint"
+grep -q "^checkpoints: 1 unfinished runs keep theirs" rec_stopped/RECORD.txt || fail "RECORD.txt: $(cat rec_stopped/RECORD.txt)"
+"$src/experiments/record_grid.sh" --out grid --to rec_stopped_plain > rec_stopped_plain.out 2>&1 || \
+  fail "record_grid.sh of the stopped grid failed: $(cat rec_stopped_plain.out)"
 
 # 2. The same command again: masa goes on from its checkpoint, sa runs, the comparison is drawn.
 "${grid[@]}" > grid2.out 2>&1 || fail "the resumed grid failed"
@@ -151,4 +161,26 @@ grep -q "2 at a time" grid6.out || fail "the hosts file's 2 slots were not used"
 [ "$(grep -c '^ssh far-host .*masa_train' remote.log)" -eq 2 ] || fail "the runs did not go through ssh to far-host"
 grep -q "^rsync -a far-host:$PWD/remote/a1_beam/masa_s0/ $PWD/remote/a1_beam/masa_s0/" remote.log || \
   fail "masa's run directory was not copied back"
-echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, recorded, hosts file used"
+# 5. restore_grid.sh: the stopped grid's record, brought back into a new directory (a new machine),
+# goes on from the recorded checkpoint and finishes; masa's run is the one that never moved (same
+# training returns, update by update: same checkpoint, same seeds). Without a checkpoint in the
+# record, the begun run starts afresh. Refused over an existing directory and for a non-grid.
+"$src/experiments/restore_grid.sh" --from rec_stopped --out restored > restore.out 2>&1 || fail "restore_grid.sh failed: $(cat restore.out)"
+grep -q "0 runs finished, 1 go on from their checkpoints, 0 start afresh" restore.out || fail "restore said: $(cat restore.out)"
+grep -q "^# restored .* from rec_stopped at commit .*: 0 finished, 1 go on" restored/grid.txt || fail "grid.txt: $(cat restored/grid.txt)"
+[ ! -e restored/RECORD.txt ] && [ ! -e restored/status.txt ] || fail "the record's own files came along"
+"$src/experiments/grid.sh" --out restored > grid7.out 2>&1 || fail "the restored grid failed: $(cat grid7.out)"
+grep -q "^masa_train: resumed at update $rows_at_kill (" restored/a1_beam/masa_s0.log || fail "the restored masa run did not go on from $rows_at_kill"
+[ -f restored/a1_beam/masa_s0/done ] && [ -f restored/a1_beam/sa_s0/done ] || fail "a restored run is not done"
+col=$(head -1 "$csv" | tr , '\n' | grep -nx return | cut -d: -f1)
+[ -n "$col" ] || fail "metrics.csv has no return column: $(head -1 "$csv")"
+cmp -s <(cut -d, -f"$col" restored/a1_beam/masa_s0/metrics.csv) <(head -n 151 "$csv" | cut -d, -f"$col") || \
+  fail "the restored run's training returns differ from the run that stayed"
+"$src/experiments/restore_grid.sh" --from rec_stopped_plain --out restored_plain > restore2.out 2>&1 || fail "restore failed: $(cat restore2.out)"
+grep -q "0 runs finished, 0 go on from their checkpoints, 1 start afresh" restore2.out && [ ! -e restored_plain/a1_beam/masa_s0 ] || \
+  fail "a run without checkpoint was not set to start afresh: $(cat restore2.out)"
+"$src/experiments/restore_grid.sh" --from rec_stopped --out restored > restore3.out 2>&1 && fail "restoring over a grid was accepted"
+grep -q "restored exists" restore3.out || fail "no reason given: $(cat restore3.out)"
+"$src/experiments/restore_grid.sh" --from rec_stopped/a1_beam --out restored4 > restore4.out 2>&1 && fail "restoring a non-grid was accepted"
+grep -q "is not a recorded grid" restore4.out && [ ! -e restored4 ] || fail "no reason given: $(cat restore4.out)"
+echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, recorded, hosts file used, restored from its record"
