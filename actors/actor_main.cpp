@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "actors/actor.hpp"
+#include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/run_key.hpp"
@@ -23,6 +24,7 @@ extern "C" void onSignal(int) { g_stop.store(true); }
 
 int main(int argc, char** argv) {
   CLI::App app{"masa actor: simulate environments and stream rollouts to the learner"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::vector<std::string> overrides;
   masa::actor::ActorOptions opt;
   std::string configs = masa::config::defaultConfigsDir();

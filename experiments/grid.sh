@@ -222,6 +222,8 @@ if [ "$replot" = 0 ]; then
     local cmd; cmd="cd $(printf '%q' "$repo") && OMP_NUM_THREADS=$threads $(printf '%q ' "$build/tools/masa_train" "${args[@]}")"
     local rc=0
     echo "# $(date -u +%FT%TZ) on $host: $cmd" >> "$log"
+    # Which code: binaries from before --version existed say nothing, and the log says so.
+    echo "# binaries: masa $("$build/tools/masa_train" --version 2> /dev/null || echo "of unknown commit (no --version)")" >> "$log"
     if [ "$host" = localhost ]; then
       bash -c "$cmd" >> "$log" 2>&1 || rc=$?
     else

@@ -14,11 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
-#include "learner/intake/drop_reason.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/run_key.hpp"
+#include "learner/intake/drop_reason.hpp"
 #include "learner/learner.hpp"
 
 namespace {
@@ -41,6 +42,7 @@ std::string timestamp() {
 
 int main(int argc, char** argv) {
   CLI::App app{"masa learner: multi-agent PPO fed by actors over LCM"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::vector<std::string> overrides;
   std::string configs = masa::config::defaultConfigsDir();
   std::string run_dir, resume_dir, url;

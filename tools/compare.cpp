@@ -20,6 +20,7 @@
 #include <regex>
 #include <sstream>
 
+#include "common/build_info/build_info.hpp"
 #include "common/stats/summary_stats.hpp"
 
 using namespace masa;
@@ -211,6 +212,7 @@ struct TaskResult {
 
 int main(int argc, char** argv) {
   CLI::App app{"masa compare: figures and verdict of a grid of runs (experiments/grid.sh)"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string dir_arg, reference = "masa";
   int resamples = 10000;
   bool no_plot = false;

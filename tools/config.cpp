@@ -4,11 +4,13 @@
 #include <iostream>
 
 #include "common/config/run_config.hpp"
+#include "common/build_info/build_info.hpp"
 #include "common/core/config_error.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Print the resolved masa run configuration"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::vector<std::string> overrides;
   std::string configs = masa::config::defaultConfigsDir();
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set ppo.horizon=8");

@@ -18,6 +18,7 @@
 #include <numeric>
 #include <regex>
 
+#include "common/build_info/build_info.hpp"
 #include "common/core/config_error.hpp"
 #include "common/dataset/dataset_log.hpp"
 #include "common/dataset/hdf5_export.hpp"
@@ -245,6 +246,7 @@ int buildFamilies(const std::string& run_arg, const std::string& out_arg, int ep
 
 int main(int argc, char** argv) {
   CLI::App app{"Offline datasets of masa: record, inspect, export (LCM logs on channel MASA_DATASET)"};
+  app.set_version_flag("--version", masa::buildCommit());
   app.require_subcommand(1);
   uint64_t seed = 0;
   int episodes = 100, threads = 1;

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/core/config_error.hpp"
 #include "common/policy/policy_file.hpp"
@@ -124,6 +125,7 @@ void film(const task::TaskFactory& factory, model::ActorCritic<float>& model, ta
 
 int main(int argc, char** argv) {
   CLI::App app{"Evaluate a trained masa policy in its task (return, progress, success, reward terms)"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string target, video, csv, save_policy;
   std::vector<std::string> overrides;
   task::EvalOptions o;

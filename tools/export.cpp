@@ -13,6 +13,7 @@
 #include <iostream>
 #include <random>
 
+#include "common/build_info/build_info.hpp"
 #include "common/onnx/policy_onnx.hpp"
 #include "common/policy/policy_file.hpp"
 
@@ -68,6 +69,7 @@ void writeReference(policy::LoadedPolicy& p, const std::string& path, int sample
 
 int main(int argc, char** argv) {
   CLI::App app{"Export a trained masa policy's mean, normalizer included, to an ONNX file"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string target, out, reference;
   int samples = 64;
   uint64_t seed = 0;

@@ -22,6 +22,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "common/build_info/build_info.hpp"
 #include "common/transport/message_mutator.hpp"
 
 namespace {
@@ -68,6 +69,7 @@ class Listener {
 
 int main(int argc, char** argv) {
   CLI::App app{"masa lcm fuzz: republish mutated copies of a live run's messages (a test's hostile publisher)"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string url, channel_regex = "MASA_.*";
   double rate = 200, duration = 0;
   uint64_t seed = 1;

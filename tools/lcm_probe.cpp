@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "common/build_info/build_info.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/message_auth.hpp"
@@ -86,6 +87,7 @@ struct ChannelLog {
 
 int main(int argc, char** argv) {
   CLI::App app{"Report message counts, sizes, rates and publication-to-reception latency on masa's LCM channels"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string url = transport::loopbackUrl();
   std::vector<std::string> channels;
   bool all = false, quiet = false;

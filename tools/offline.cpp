@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "common/build_info/build_info.hpp"
 #include "common/core/config_error.hpp"
 #include "common/dataset/dataset_log.hpp"
 #include "common/policy/policy_file.hpp"
@@ -49,6 +50,7 @@ std::string envOf(const std::string& target) {
 
 int main(int argc, char** argv) {
   CLI::App app{"masa offline: BC or IQL on recorded datasets, as SA, SASA-data or MASA"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::vector<std::string> logs, overrides;
   std::string algo = "iql", method = "masa", run_dir, configs = config::defaultConfigsDir(), recipe, env_of;
   long long steps = 0;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/core/config_error.hpp"
 #include "common/model/actor_critic.hpp"
@@ -21,6 +22,7 @@ using namespace masa;
 
 int main(int argc, char** argv) {
   CLI::App app{"Roll out a policy in a masa task and report rewards term by term"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string task_name = "humanoid_tightrope", checkpoint, video;
   std::vector<std::string> overrides;
   int episodes = 3, max_steps = 0, width = 640, height = 480, strip = 8;

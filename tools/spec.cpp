@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "common/build_info/build_info.hpp"
 #include "common/core/config_error.hpp"
 #include "common/model/equivariance_check.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
@@ -35,6 +36,7 @@ void printMap(const sym::SparseMap& m, const std::vector<std::string>& names) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Inspect a masa symmetry spec and check its group laws and MASA's equivariance"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string path;
   bool show_maps = false;
   std::uint64_t seed = 0;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "common/build_info/build_info.hpp"
 #include "common/task/found_spec_writer.hpp"
 #include "common/task/symmetry_candidate_check.hpp"
 #include "common/task/symmetry_finder.hpp"
@@ -41,6 +42,7 @@ bool writeFile(const std::string& path, const std::string& text) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Find a robot's symmetries (mirror planes, rotation axes) from its MJCF and write them as a spec"};
+  app.set_version_flag("--version", masa::buildCommit());
   app.require_subcommand(1);
   auto* find = app.add_subcommand("find", "propose the symmetries of a model, optionally proven by simulation");
   std::string model_file, out_file, task_file;

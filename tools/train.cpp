@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "actors/actor.hpp"
+#include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
 #include "learner/learner.hpp"
@@ -28,6 +29,7 @@ extern "C" void onSignal(int) { g_stop.store(true); }
 
 int main(int argc, char** argv) {
   CLI::App app{"masa train: learner and one actor in one process (deterministic, no network)"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::vector<std::string> overrides;
   std::string configs = masa::config::defaultConfigsDir();
   std::string run_dir;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/core/config_error.hpp"
 #include "common/task/imperfection_report.hpp"
@@ -17,6 +18,7 @@ using namespace masa;
 
 int main(int argc, char** argv) {
   CLI::App app{"Check step(T s, T a) = T step(s, a) and obs(T s) = T obs(s) by simulation"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string task_name, model_file, spec_file;
   std::vector<std::string> overrides;
   task::SymmetryVerifierOptions opt;

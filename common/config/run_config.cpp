@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "common/build_info/build_info.hpp"
 #include "common/core/config_error.hpp"
 
 namespace masa::config {
@@ -338,6 +339,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
 std::string dumpResolved(const RunConfig& config) {
   std::ostringstream os;
   os << "# Resolved masa run configuration (defaults < task file < command line).\n";
+  os << "# Written by masa " << buildCommit() << "\n";
   std::map<std::string, int> files;
   for (const auto& [key, file] : config.origin) files[file]++;
   for (const auto& [file, n] : files) os << "# " << n << " key(s) from " << file << "\n";

@@ -4,9 +4,9 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "common/build_info/build_info.hpp"
 #include "common/model/agent_maps.hpp"
 #include "common/onnx/onnx_graph.hpp"
-#include "masa/git_commit.hpp"
 
 namespace masa::onnx_export {
 namespace {
@@ -128,7 +128,7 @@ void addMetadata(onnx::ModelProto& m, const policy::LoadedPolicy& p) {
   add("observation_names", joined(p.spec.obsNames()));
   add("action_names", joined(p.spec.actNames()));
   add("activation", nn::activationName(p.config.model.activation));
-  add("masa_commit", MASA_GIT_COMMIT);
+  add("masa_commit", masa::buildCommit());
   add("source_policy", p.source);
 }
 
@@ -144,7 +144,7 @@ onnx::ModelProto buildPolicyOnnx(const policy::LoadedPolicy& policy) {
   onnx::ModelProto m;
   m.set_ir_version(kIrVersion);
   m.set_producer_name("masa");
-  m.set_producer_version(MASA_GIT_COMMIT);
+  m.set_producer_version(masa::buildCommit());
   m.set_doc_string("Policy mean of a masa policy file, observation normalizer included: feed raw observations.");
   auto* opset = m.add_opset_import();
   opset->set_domain("");

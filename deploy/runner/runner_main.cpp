@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/build_info/build_info.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/transport/transport.hpp"
 #include "deploy/runner/deploy_config.hpp"
@@ -101,6 +102,7 @@ void waitForWork(transport::Transport& lcm, deploy::PolicyRunner& runner, const 
 
 int main(int argc, char** argv) {
   CLI::App app{"masa_deploy: run a trained policy on a robot over LCM"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string policy_path, config_file, url;
   std::vector<std::string> sets;
   double duration_s = 0;

@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/build_info/build_info.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/task/registry.hpp"
 #include "common/transport/channels.hpp"
@@ -47,6 +48,7 @@ struct Pending {
 
 int main(int argc, char** argv) {
   CLI::App app{"masa_sim_robot: a task's robot in MuJoCo, in real time, over LCM"};
+  app.set_version_flag("--version", masa::buildCommit());
   std::string policy_path, url, state_channel = transport::kRobotStateChannel,
                                 command_channel = transport::kRobotCommandChannel;
   uint64_t seed = 0, fault_seed = 1;

@@ -64,6 +64,11 @@ grep -Eq "^grid.sh: 1 done, [01] running, .* of 300 updates \([0-9]+%\); ETA [0-
   fail "no progress line after the first finished run: $(cat grid2.out)"
 grep -q -- "--resume .*masa_s0" grid/a1_beam/masa_s0.log || fail "masa's run was not resumed from its checkpoint"
 [ -f grid/a1_beam/masa_s0/done ] && [ -f grid/a1_beam/sa_s0/done ] || fail "a run is not marked done"
+# Which code made each run: the log names the binaries' commit at every start, config.yaml too.
+version=$("$build/tools/masa_train" --version) || fail "masa_train --version failed"
+[[ "$version" =~ ^([0-9a-f]{7,}(-dirty)?|unknown)$ ]] || fail "masa_train --version printed '$version'"
+[ "$(grep -c "^# binaries: masa $version\$" grid/a1_beam/masa_s0.log)" -eq 2 ] || fail "masa's log does not name the binaries twice"
+grep -qx "# Written by masa $version" grid/a1_beam/sa_s0/config.yaml || fail "config.yaml does not name the commit"
 [ "$(($(wc -l < "$csv") - 1))" -eq 150 ] || fail "masa's metrics.csv has $(($(wc -l < "$csv") - 1)) rows, not 150"
 # One row per update, no update twice: the epochs are 0..149 in order.
 awk -F, 'NR > 1 && $1 != NR - 2 { bad = 1 } END { exit bad }' "$csv" || fail "masa's epochs are not 0..149 in order"
