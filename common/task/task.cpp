@@ -364,22 +364,16 @@ void Task::applySymmetry(int i) {
   t.apply<double>(a, ta);
   std::copy(ta.data(), ta.data() + actDim(), last_action_.begin());
   transformExtras(i);
-  mj_forward(model_->get(), data_);
+  forwardKeepingState();
 }
 
-void Task::copyStateFrom(const Task& other) {
-  MASA_CHECK(other.name_ == name_ && other.model()->nq == model()->nq, "copyStateFrom needs the same task");
+void Task::forwardKeepingState() {
   const mjModel* m = model_->get();
-  data_->time = other.data_->time;
-  std::copy(other.data_->qpos, other.data_->qpos + m->nq, data_->qpos);
-  std::copy(other.data_->qvel, other.data_->qvel + m->nv, data_->qvel);
-  std::copy(other.data_->act, other.data_->act + m->na, data_->act);
-  std::copy(other.data_->ctrl, other.data_->ctrl + m->nu, data_->ctrl);
-  std::copy(other.data_->qacc_warmstart, other.data_->qacc_warmstart + m->nv, data_->qacc_warmstart);
-  last_action_ = other.last_action_;
-  episode_ = other.episode_;
-  copyExtrasFrom(other);
+  std::copy(data_->qpos, data_->qpos + m->nq, qpos_scratch_.begin());
+  std::copy(data_->qacc_warmstart, data_->qacc_warmstart + m->nv, qvel_scratch_.begin());
   mj_forward(m, data_);
+  std::copy(qpos_scratch_.begin(), qpos_scratch_.begin() + m->nq, data_->qpos);
+  std::copy(qvel_scratch_.begin(), qvel_scratch_.begin() + m->nv, data_->qacc_warmstart);
 }
 
 }  // namespace masa::task

@@ -87,6 +87,13 @@ class Task {
   void applySymmetry(int i);
   // Copies the full state (simulator and task extras) of another instance of the same task.
   void copyStateFrom(const Task& other);
+  // The full state as numbers (common/task/task_state.cpp): the simulator's (time, qpos, qvel, act,
+  // ctrl, warm start, applied forces, mocap, user data), the last action, the episode so far and
+  // the task's extras. saveState appends; loadState takes exactly what saveState of the same task
+  // and model wrote (a size that differs throws, naming it), then mj_forward. An actor saved with
+  // its environments goes on as if it had not stopped.
+  void saveState(std::vector<double>& out) const;
+  void loadState(std::span<const double> in);
 
   // --- deployment: a robot's measured state in place of the simulator's own (masa_deploy) ---
   // The joint command the task's actuation turns `action` (action order, clamped to [-1, 1]) into,
@@ -150,9 +157,12 @@ class Task {
   virtual void afterStep() {}
   virtual bool hasSuccessMeasure() const { return false; }
   virtual bool isSuccess() const { return false; }
-  // Task-owned state beyond qpos/qvel/ctrl/last action (a goal pose, a route) under T_i, and copies.
+  // Task-owned state beyond qpos/qvel/ctrl/last action (a goal pose, a route): under T_i, and as
+  // numbers for copies and saved states. loadExtras reads what saveExtras wrote, all of it (the
+  // base class checks that nothing is left over); a count that cannot be throws.
   virtual void transformExtras(int i) {}
-  virtual void copyExtrasFrom(const Task& other) {}
+  virtual void saveExtras(std::vector<double>& out) const {}
+  virtual void loadExtras(std::span<const double> in) {}
 
   // --- helpers for tasks ---
   int frameSkip() const { return frame_skip_; }
@@ -177,6 +187,11 @@ class Task {
   void bindActuators();
   void setControls(const float* action);  // clamp, remember as the last action, applyAction
   void transformJoints(int i);
+  // mj_forward for a state set from outside (loaded, transformed): the derived quantities, while
+  // the two parts of the state mj_forward writes stay as set. It normalizes the quaternions in qpos
+  // again (not idempotent in floating point) and leaves its solution in the warm start, where the
+  // next step starts from; either would make the next step differ from the state's own.
+  void forwardKeepingState();
 
   std::string name_;
   sym::SymmetrySpec spec_;

@@ -192,10 +192,13 @@ class YamlTask final : public Task {
     heading_ = g * heading_;
     start_ = g * start_;
   }
-  void copyExtrasFrom(const Task& other) override {
-    const auto& o = static_cast<const YamlTask&>(other);
-    heading_ = o.heading_;
-    start_ = o.start_;
+  void saveExtras(std::vector<double>& out) const override {
+    out.insert(out.end(), {heading_.x(), heading_.y(), heading_.z(), start_.x(), start_.y(), start_.z()});
+  }
+  void loadExtras(std::span<const double> in) override {
+    if (in.size() != 6) throw std::runtime_error(name() + " state: 6 extras (heading, start) expected, got " + std::to_string(in.size()));
+    heading_ = Eigen::Vector3d(in[0], in[1], in[2]);
+    start_ = Eigen::Vector3d(in[3], in[4], in[5]);
   }
 
  private:

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "tasks/tasks.hpp"
 
@@ -147,12 +149,26 @@ void HumanoidDribbling::transformExtras(int i) {
   }
 }
 
-void HumanoidDribbling::copyExtrasFrom(const Task& other) {
-  const auto& o = static_cast<const HumanoidDribbling&>(other);
-  route_ = o.route_;
-  length_ = o.length_;
-  current_ = o.current_;
-  start_z_ = o.start_z_;
+void HumanoidDribbling::saveExtras(std::vector<double>& out) const {
+  out.push_back(static_cast<double>(route_.size()));
+  for (const PlanarFrame& f : route_) out.insert(out.end(), {f.x, f.y, f.heading});
+  out.insert(out.end(), length_.begin(), length_.end());
+  out.insert(out.end(), {static_cast<double>(current_), start_z_});
+}
+
+void HumanoidDribbling::loadExtras(std::span<const double> in) {
+  // The route's segments, their frames and lengths, the current one and the start height.
+  const double n = in.empty() ? -1.0 : in[0];
+  if (!(n >= 0.0 && n == std::floor(n) && in.size() == 1 + 4 * static_cast<std::size_t>(n) + 2))
+    throw std::runtime_error("humanoid_dribbling state: " + std::to_string(in.size()) +
+                             " values of route, which cannot be a route of " + std::to_string(n) + " segments");
+  const std::size_t segments = static_cast<std::size_t>(n);
+  route_.resize(segments);
+  length_.resize(segments);
+  for (std::size_t k = 0; k < segments; ++k) route_[k] = {in[1 + 3 * k], in[2 + 3 * k], in[3 + 3 * k]};
+  for (std::size_t k = 0; k < segments; ++k) length_[k] = in[1 + 3 * segments + k];
+  current_ = static_cast<int>(in[1 + 4 * segments]);
+  start_z_ = in[2 + 4 * segments];
 }
 
 // Listed in tasks/tasks.cpp.

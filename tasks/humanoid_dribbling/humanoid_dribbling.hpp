@@ -32,7 +32,8 @@ class HumanoidDribbling final : public HumanoidTask {
   bool isTerminated() const override;
   void afterStep() override;
   void transformExtras(int i) override;
-  void copyExtrasFrom(const Task& other) override;
+  void saveExtras(std::vector<double>& out) const override;
+  void loadExtras(std::span<const double> in) override;
 
  private:
   const double* ballPos() const;

@@ -65,9 +65,11 @@ class HumanoidTightrope final : public HumanoidTask {
 
   bool isTerminated() const override { return torsoPos()[2] < start_z_ - fall_height_; }
 
-  void copyExtrasFrom(const Task& other) override {
-    start_z_ = static_cast<const HumanoidTightrope&>(other).start_z_;
-    start_x_ = static_cast<const HumanoidTightrope&>(other).start_x_;
+  void saveExtras(std::vector<double>& out) const override { out.insert(out.end(), {start_z_, start_x_}); }
+  void loadExtras(std::span<const double> in) override {
+    if (in.size() != 2) throw std::runtime_error("humanoid_tightrope state: 2 extras expected, got " + std::to_string(in.size()));
+    start_z_ = in[0];
+    start_x_ = in[1];
   }
   // start_z_ is a height: invariant under the mirror, so transformExtras keeps the default.
 

@@ -185,10 +185,14 @@ class TrifingerLift final : public Task {
       for (int d = 3; d < 7; ++d) data_->qpos[cube_qpos_ + d] = -data_->qpos[cube_qpos_ + d];
   }
 
-  void copyExtrasFrom(const Task& other) override {
-    const auto& o = static_cast<const TrifingerLift&>(other);
-    goal_pos_ = o.goal_pos_;
-    goal_quat_ = o.goal_quat_;
+  void saveExtras(std::vector<double>& out) const override {
+    out.insert(out.end(), {goal_pos_.x(), goal_pos_.y(), goal_pos_.z(), goal_quat_.w(), goal_quat_.x(), goal_quat_.y(),
+                           goal_quat_.z()});
+  }
+  void loadExtras(std::span<const double> in) override {
+    if (in.size() != 7) throw std::runtime_error("trifinger_lift state: 7 extras (the goal pose) expected, got " + std::to_string(in.size()));
+    goal_pos_ = Eigen::Vector3d(in[0], in[1], in[2]);
+    goal_quat_ = Eigen::Quaterniond(in[3], in[4], in[5], in[6]);
   }
 
  private:
