@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <iosfwd>
 #include <memory>
 #include <optional>
 #include <string>
@@ -117,6 +118,14 @@ class Actor {
   int numEnvs() const { return num_envs_; }
   model::ActorCritic<float>& model() { return *model_; }
   void publishHeartbeat();
+
+  // The environments between two rollouts (actors/actor_environments.cpp): each task's state and
+  // each environment's generator. An actor of the same run config that loads them collects the
+  // same rollouts as this one would have (masa_train saves them beside the learner's checkpoint).
+  // Loading throws, naming what does not fit: another task, another number of environments, a
+  // file cut short; nothing is changed then.
+  void saveEnvironments(std::ostream& out) const;
+  void loadEnvironments(std::istream& in);
 
  private:
   void onParams(const masa::lcmt_policy_params& msg);

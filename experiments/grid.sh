@@ -10,9 +10,8 @@
 # Resumable: run the same command again (or with --out DIR) after a kill. A finished run (its
 # `done` file) is not redone, a run with a checkpoint goes on from it, the rest start afresh.
 # Runs are taken seed by seed, so a grid stopped early has whole seeds of every method.
-# --extend N raises the grid's updates to N: every run goes on from its checkpoint (as after a
-# kill, the environments restart from a reset there, so an extended run is not bit-identical to
-# one trained to N from the start); grid.txt records when and from how many.
+# --extend N raises the grid's updates to N: every run goes on from its checkpoint and its
+# environments (actor_state.bin), as after a kill; grid.txt records when and from how many.
 # Results: DIR/<task>/<method>_s<seed>/ (run directories: config.yaml, metrics.csv, policy.bin, ...,
 # and <method>_s<seed>.log), DIR/grid.txt (the grid), DIR/<task>/compare*.png and verdict.md.
 # --hosts FILE: one line per host, "name [slots]" ("localhost" runs here). Remote hosts need this
@@ -44,7 +43,7 @@ while [ $# -gt 0 ]; do
     --replot) replot=1; shift ;;
     --extend) extend=$2; shift 2 ;;
     --status) status=1; shift ;;
-    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -4,8 +4,9 @@
 # recorded, every run's config.yaml, metrics.csv and log, the grid's definition and status, and
 # RECORD.txt (when, from which commit, on what machine, where each run was resumed); no
 # checkpoints, policies or per-run PNGs, which the repository does not need (--policies keeps them).
-# --checkpoints keeps the checkpoints of the runs not yet finished, so that restore_grid.sh can bring
-# the grid back on another machine (or in a later session, whose machine is new) and go on.
+# --checkpoints keeps the checkpoints of the runs not yet finished (with their environments,
+# actor_state.bin), so that restore_grid.sh can bring the grid back on another machine (or in a
+# later session, whose machine is new) and go on.
 #
 #   experiments/record_grid.sh --out runs/grid_ant --to experiments/results/ant_acrobatic_grid_2026-12-05
 #
@@ -13,7 +14,7 @@
 # move under the copy). MASA_BUILD_DIR chooses the build whose masa_compare redraws (default build).
 set -euo pipefail
 
-usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
+usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
 out="" to="" force=0 policies=0 checkpoints=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -46,11 +47,12 @@ mkdir -p "$to"
 excludes=(--exclude=learning_curve.png --exclude=learning_curve.log
           --exclude=.grid.lock --exclude=.queue --exclude=.queue.lock --exclude=.slots)
 [ "$policies" = 1 ] || excludes+=(--exclude=policy.bin)
-[ "$checkpoints" = 1 ] || excludes+=(--exclude=checkpoint.bin)
+[ "$checkpoints" = 1 ] || excludes+=(--exclude=checkpoint.bin --exclude=actor_state.bin)
+excludes+=(--exclude=actor_state.bin.tmp)
 "$here/grid.sh" --status --out "$out" > "$to/status.txt"
 tar -C "$out" "${excludes[@]}" -cf - . | tar -C "$to" -xf -
 # A finished run's checkpoint would only serve grid.sh --extend: not worth its megabytes here.
-find "$to" -mindepth 3 -maxdepth 3 -name done -execdir rm -f checkpoint.bin \;
+find "$to" -mindepth 3 -maxdepth 3 -name done -execdir rm -f checkpoint.bin actor_state.bin \;
 
 repo=$(cd "$here/.." && pwd)
 commit=$(git -C "$repo" rev-parse HEAD 2> /dev/null || echo unknown)
@@ -70,17 +72,17 @@ dirty=$(git -C "$repo" status --porcelain --untracked-files=no -- . "${exclude[@
     echo "checkpoints: $(find "$to" -name checkpoint.bin | wc -l) unfinished runs keep theirs" \
          "(experiments/restore_grid.sh --from $to --out DIR brings the grid back to go on)"
   fi
-  # A resume restarts the run's environments from a reset (the checkpoint holds the learner only),
-  # which shows in its curves: where each run went on, from its log. masa_train says it ("resumed
-  # at update K"); before it did, the update where the previous process stopped stands in ("?"
+  # Where each run went on, from its log. masa_train says it ("resumed at update K"), and whether
+  # its environments went on as they were (actor_state.bin: "exact") or from a reset, which shows
+  # in the curves; before it said so, the update where the previous process stopped stands in ("?"
   # after a hard stop, which left no such line).
-  echo "resumes (update at which a run went on from its checkpoint, environments reset there):"
+  echo "resumes (update at which a run went on from its checkpoint; environments reset there unless marked exact):"
   for log in "$out"/*/*_s*.log; do
     [ -f "$log" ] || continue
     points=$(awk 'function flush() { if (pending) printf "%s ", guess == "" ? "?" : guess; pending = 0 }
                   /^# .* on .*: / { flush() }
                   /^# .* --resume / { pending = 1; guess = last; last = "" }
-                  /^masa_train: resumed at update [0-9]+/ { if (pending) printf "%s ", $5; pending = 0 }
+                  /^masa_train: resumed at update [0-9]+/ { if (pending) printf "%s%s ", $5, (/go on as they were/ ? "(exact)" : ""); pending = 0 }
                   /^masa_train: [0-9]+ updates,/ { last = $2 }
                   END { flush() }' "$log")
     run=${log#"$out"/}

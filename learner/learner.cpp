@@ -294,6 +294,7 @@ void Learner::writeCheckpoint() {
   learner::writeCheckpoint((fs::path(dir_) / "checkpoint.bin").string(), s, *model_, *adam_);
   // What inference needs, for evaluation and deployment (masa_eval, the robot runner).
   policy::savePolicyFile((fs::path(dir_) / "policy.bin").string(), rc_, *model_);
+  if (checkpoint_hook_) checkpoint_hook_(updates_);
 }
 
 void Learner::loadCheckpoint() {

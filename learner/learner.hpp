@@ -15,6 +15,7 @@
 #include <cmath>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -63,6 +64,9 @@ class Learner {
   void run(int64_t max_updates, const std::atomic<bool>* stop);
 
   void writeCheckpoint();
+  // Called after each checkpoint is written, with its update count: masa_train saves its actor's
+  // environments then, so that a resume goes on exactly (tools/train.cpp).
+  void setCheckpointHook(std::function<void(int64_t updates)> hook) { checkpoint_hook_ = std::move(hook); }
   void writeSnapshot();
   void publishParams();
   // The total number of updates planned, for the progress line's ETA (run() sets it too).
@@ -130,6 +134,7 @@ class Learner {
   // The task, built once, for the evaluations of runner.eval_every (null when they are off).
   std::unique_ptr<task::TaskFactory> eval_factory_;
   ReportColumns columns_;  // reward terms (from the first chunk) and the task's progress figures
+  std::function<void(int64_t)> checkpoint_hook_;
 };
 
 }  // namespace masa::learner

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "actors/actor.hpp"
+#include "actors/environments_snapshot.hpp"
 #include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
@@ -83,17 +84,28 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "masa_train: %s / %s, %d envs x %d steps per update, %lld updates, run dir %s\n",
                  rc.task.c_str(), masa::model::methodName(rc.method).c_str(), rc.ppo.num_envs, rc.ppo.horizon,
                  static_cast<long long>(updates), learner.runDir().c_str());
-    // The checkpoint holds the learner, not the environments: say where the curves will show it.
-    if (lo.resume)
-      std::fprintf(stderr, "masa_train: resumed at update %lld (%lld env steps); the environments start from a reset here\n",
-                   static_cast<long long>(learner.updates()), static_cast<long long>(learner.envSteps()));
+    // The environments go beside the learner's checkpoint (actor_state.bin), as they were between
+    // the two rollouts the checkpoint lies between: a resume goes on exactly, as if never stopped.
+    // Without them (an older run, a mismatch) the environments start from a reset; say which.
+    const std::string env_path = learner.runDir() + "/actor_state.bin";
+    if (lo.resume) {
+      const std::string why = masa::actor::resumeEnvironments(env_path, learner.updates(), actor);
+      std::fprintf(stderr, "masa_train: resumed at update %lld (%lld env steps); %s\n",
+                   static_cast<long long>(learner.updates()), static_cast<long long>(learner.envSteps()),
+                   why.empty() ? "the environments go on as they were (actor_state.bin)"
+                               : ("the environments start from a reset here (" + why + ")").c_str());
+    }
+    masa::actor::EnvironmentsSnapshot snapshot;
+    snapshot.take(actor, learner.updates());
+    learner.setCheckpointHook([&](int64_t at) { snapshot.writeIfAt(at, env_path); });
 
     while (!g_stop.load() && learner.updates() < updates) {
       if (!actor.pollParams(0)) {
         learner.publishParams();  // the first broadcast may predate the actor's subscription
         if (!actor.pollParams(0)) throw std::runtime_error("the actor received no parameters from the learner");
       }
-      if (!actor.collectAndPublish()) break;  // stopped mid-rollout
+      if (!actor.collectAndPublish()) break;  // stopped mid-rollout: the last snapshot is the boundary
+      snapshot.take(actor, learner.updates() + 1);  // between this rollout and the next: the update it makes
       bool updated = false;
       for (int tries = 0; !updated && tries < 100; ++tries) updated = learner.step(0);
       if (!updated) throw std::runtime_error("the learner made no update from a whole rollout (see its warnings)");

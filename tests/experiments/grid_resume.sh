@@ -52,7 +52,8 @@ grep -Eq "^0 done, 0 running, 1 stopped, 1 waiting; $rows_at_kill of 300 updates
 # keeps when its machine goes), and without.
 "$src/experiments/record_grid.sh" --out grid --to rec_stopped --checkpoints > rec_stopped.out 2>&1 || \
   fail "record_grid.sh --checkpoints failed: $(cat rec_stopped.out)"
-[ -s rec_stopped/a1_beam/masa_s0/checkpoint.bin ] || fail "--checkpoints did not keep the stopped run's checkpoint"
+[ -s rec_stopped/a1_beam/masa_s0/checkpoint.bin ] && [ -s rec_stopped/a1_beam/masa_s0/actor_state.bin ] || \
+  fail "--checkpoints did not keep the stopped run's checkpoint and environments"
 grep -q "^checkpoints: 1 unfinished runs keep theirs" rec_stopped/RECORD.txt || fail "RECORD.txt: $(cat rec_stopped/RECORD.txt)"
 "$src/experiments/record_grid.sh" --out grid --to rec_stopped_plain > rec_stopped_plain.out 2>&1 || \
   fail "record_grid.sh of the stopped grid failed: $(cat rec_stopped_plain.out)"
@@ -119,7 +120,7 @@ for f in verdict.md grid.txt status.txt RECORD.txt a1_beam/runs.csv a1_beam/masa
   [ -s "rec/$f" ] || fail "the record has no $f"
 done
 [ -s grid/verdict.md ] || fail "record_grid.sh did not redraw the comparison first"
-left_in=$(find rec -name checkpoint.bin -o -name policy.bin -o -name learning_curve.png -o -name '.grid.lock')
+left_in=$(find rec -name checkpoint.bin -o -name actor_state.bin -o -name policy.bin -o -name learning_curve.png -o -name '.grid.lock')
 [ -z "$left_in" ] || fail "the record keeps what it should leave out: $left_in"
 cmp -s rec/a1_beam/masa_s0/metrics.csv grid/a1_beam/masa_s0/metrics.csv || fail "the recorded metrics differ"
 grep -Eq "^checkout: [0-9a-f]{40}" rec/RECORD.txt && grep -q "^grid: tasks=a1_beam methods=masa sa" rec/RECORD.txt || \
@@ -129,8 +130,8 @@ grep -q "^2 done, 0 running" rec/status.txt || fail "the recorded status: $(cat 
 # masa_train says so in the log; logs of binaries from before that give the same from where each
 # process stopped.
 grep -q "^masa_train: resumed at update $rows_at_kill (" grid/a1_beam/masa_s0.log || fail "masa_train did not say where it resumed"
-grep -Eq "^  a1_beam/masa_s0: $rows_at_kill 150 \$" rec/RECORD.txt && grep -Eq "^  a1_beam/sa_s0: 150 \$" rec/RECORD.txt || \
-  fail "RECORD.txt does not list the resumes: $(cat rec/RECORD.txt)"
+grep -Eq "^  a1_beam/masa_s0: $rows_at_kill\(exact\) 150\(exact\) \$" rec/RECORD.txt && \
+  grep -Eq "^  a1_beam/sa_s0: 150\(exact\) \$" rec/RECORD.txt || fail "RECORD.txt does not list the resumes: $(cat rec/RECORD.txt)"
 cp -a grid grid_old_logs && sed -i '/^masa_train: resumed at update/d' grid_old_logs/a1_beam/*.log
 "$src/experiments/record_grid.sh" --out grid_old_logs --to rec_old > rec_old.out 2>&1 || fail "record_grid.sh failed: $(cat rec_old.out)"
 grep -Eq "^  a1_beam/masa_s0: $rows_at_kill 150 \$" rec_old/RECORD.txt || fail "resumes from older logs: $(cat rec_old/RECORD.txt)"
