@@ -176,7 +176,8 @@ grep -q "0 runs finished, 1 go on from their checkpoints, 0 start afresh" restor
 grep -q "^# restored .* from rec_stopped at commit .*: 0 finished, 1 go on" restored/grid.txt || fail "grid.txt: $(cat restored/grid.txt)"
 [ ! -e restored/RECORD.txt ] && [ ! -e restored/status.txt ] || fail "the record's own files came along"
 "$src/experiments/grid.sh" --out restored > grid7.out 2>&1 || fail "the restored grid failed: $(cat grid7.out)"
-grep -q "^masa_train: resumed at update $rows_at_kill (" restored/a1_beam/masa_s0.log || fail "the restored masa run did not go on from $rows_at_kill"
+grep -q "^masa_train: resumed at update $rows_at_kill (.*); the environments go on as they were" restored/a1_beam/masa_s0.log || \
+  fail "the restored masa run did not go on from $rows_at_kill with its environments: $(grep resumed restored/a1_beam/masa_s0.log)"
 [ -f restored/a1_beam/masa_s0/done ] && [ -f restored/a1_beam/sa_s0/done ] || fail "a restored run is not done"
 col=$(head -1 "$csv" | tr , '\n' | grep -nx return | cut -d: -f1)
 [ -n "$col" ] || fail "metrics.csv has no return column: $(head -1 "$csv")"
