@@ -11,41 +11,40 @@
 #include <vector>
 
 #include "actors/actor.hpp"
+#include "common/core/binary_io.hpp"
 
 namespace masa::actor {
 namespace {
 
 constexpr std::uint64_t kEnvironmentsTag = 0x3173766e45415341ull;  // "ASAEnvs1", little-endian
 
-template <class T>
-void put(std::ostream& out, const T& v) {
-  out.write(reinterpret_cast<const char*>(&v), sizeof v);
-}
 void putBytes(std::ostream& out, const std::string& s) {
-  put(out, static_cast<std::uint64_t>(s.size()));
-  out.write(s.data(), static_cast<std::streamsize>(s.size()));
+  io::writePod(out, static_cast<std::uint64_t>(s.size()));
+  io::writeArray(out, s.data(), s.size());
 }
+
+[[noreturn]] void cutShort(const std::string& what) { throw std::runtime_error("actor environments: cut short in " + what); }
 
 template <class T>
 T get(std::istream& in, const char* what) {
   T v{};
-  if (!in.read(reinterpret_cast<char*>(&v), sizeof v)) throw std::runtime_error(std::string("actor environments: cut short in ") + what);
+  if (!io::readPod(in, v)) cutShort(what);
   return v;
 }
 std::string getBytes(std::istream& in, std::uint64_t limit, const char* what) {
   const auto n = get<std::uint64_t>(in, what);
   if (n > limit) throw std::runtime_error(std::string("actor environments: ") + what + " of " + std::to_string(n) + " bytes");
   std::string s(n, '\0');
-  if (!in.read(s.data(), static_cast<std::streamsize>(n))) throw std::runtime_error(std::string("actor environments: cut short in ") + what);
+  if (!io::readArray(in, s.data(), n)) cutShort(what);
   return s;
 }
 
 }  // namespace
 
 void Actor::saveEnvironments(std::ostream& out) const {
-  put(out, kEnvironmentsTag);
+  io::writePod(out, kEnvironmentsTag);
   putBytes(out, config_.task);
-  put(out, static_cast<std::int64_t>(num_envs_));
+  io::writePod(out, static_cast<std::int64_t>(num_envs_));
   std::vector<double> state;
   for (int e = 0; e < num_envs_; ++e) {
     std::ostringstream rng_text;
@@ -53,8 +52,8 @@ void Actor::saveEnvironments(std::ostream& out) const {
     putBytes(out, rng_text.str());
     state.clear();
     envs_[e]->saveState(state);
-    put(out, static_cast<std::uint64_t>(state.size()));
-    out.write(reinterpret_cast<const char*>(state.data()), static_cast<std::streamsize>(state.size() * sizeof(double)));
+    io::writePod(out, static_cast<std::uint64_t>(state.size()));
+    io::writeArray(out, state.data(), state.size());
   }
   if (!out) throw std::runtime_error("actor environments: writing failed");
 }
@@ -77,8 +76,7 @@ void Actor::loadEnvironments(std::istream& in) {
     const auto count = get<std::uint64_t>(in, "a task state's size");
     if (count > (1u << 24)) throw std::runtime_error("actor environments: a task state of " + std::to_string(count) + " values");
     states[e].resize(count);
-    if (!in.read(reinterpret_cast<char*>(states[e].data()), static_cast<std::streamsize>(count * sizeof(double))))
-      throw std::runtime_error("actor environments: cut short in environment " + std::to_string(e) + "'s task state");
+    if (!io::readArray(in, states[e].data(), count)) cutShort("environment " + std::to_string(e) + "'s task state");
   }
   if (in.peek() != std::char_traits<char>::eof()) throw std::runtime_error("actor environments: bytes after the last environment");
   auto probe = factory_->create();  // each state is checked on a spare task before any is applied

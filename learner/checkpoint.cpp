@@ -5,22 +5,21 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "common/core/binary_io.hpp"
+
 namespace masa::learner {
 namespace fs = std::filesystem;
 namespace {
 
 constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'C', 'K', 'P', '1'};
 
-template <class T>
-void writePod(std::ostream& os, const T& v) {
-  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
+using io::writeArray;
+using io::writePod;
 
 template <class T>
 T readPod(std::istream& is, const std::string& path) {
   T v{};
-  is.read(reinterpret_cast<char*>(&v), sizeof(T));
-  if (!is) throw std::runtime_error(path + ": truncated checkpoint");
+  if (!io::readPod(is, v)) throw std::runtime_error(path + ": truncated checkpoint");
   return v;
 }
 
@@ -39,9 +38,9 @@ void writeCheckpoint(const std::string& path, const CheckpointState& s, const mo
     writePod(os, s.wall_time_s);
     writePod(os, s.lr);
     writePod(os, static_cast<uint64_t>(s.rng_state.size()));
-    os.write(s.rng_state.data(), static_cast<std::streamsize>(s.rng_state.size()));
+    writeArray(os, s.rng_state.data(), s.rng_state.size());
     writePod(os, static_cast<uint64_t>(s.order.size()));
-    os.write(reinterpret_cast<const char*>(s.order.data()), static_cast<std::streamsize>(s.order.size() * sizeof(int)));
+    writeArray(os, s.order.data(), s.order.size());
     model.save(os);
     adam.save(os);
     os.flush();
@@ -74,12 +73,11 @@ CheckpointState readCheckpoint(const std::string& path, model::ActorCritic<float
   const uint64_t rn = readPod<uint64_t>(is, path);
   if (rn > (1u << 20)) throw std::runtime_error(path + ": corrupt rng state");
   s.rng_state.assign(rn, '\0');
-  is.read(s.rng_state.data(), static_cast<std::streamsize>(rn));
+  if (!io::readArray(is, s.rng_state.data(), rn)) throw std::runtime_error(path + ": truncated checkpoint");
   const uint64_t on = readPod<uint64_t>(is, path);
   if (on > (1ull << 31)) throw std::runtime_error(path + ": corrupt shuffle order");
   s.order.resize(on);
-  is.read(reinterpret_cast<char*>(s.order.data()), static_cast<std::streamsize>(on * sizeof(int)));
-  if (!is) throw std::runtime_error(path + ": truncated checkpoint");
+  if (!io::readArray(is, s.order.data(), on)) throw std::runtime_error(path + ": truncated checkpoint");
   model.load(is, path);
   if (adam) adam->load(is);
   return s;

@@ -5,6 +5,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "common/core/binary_io.hpp"
 #include "common/nn/serialize.hpp"
 
 namespace masa::model {
@@ -181,7 +182,7 @@ void ActorCritic<S>::save(std::ostream& os) const {
   os.write(kMagic, sizeof kMagic);
   const std::string method = methodName(config_.method);
   const int32_t len = static_cast<int32_t>(method.size());
-  os.write(reinterpret_cast<const char*>(&len), sizeof len);
+  io::writePod(os, len);
   os.write(method.data(), len);
   nn::saveParameters(params_, os);
   obs_norm_.save(os);
@@ -195,8 +196,7 @@ void ActorCritic<S>::load(std::istream& is, const std::string& source_name) {
   if (!is || std::string(magic, 8) != std::string(kMagic, 8))
     throw std::runtime_error(source_name + ": not a masa model (bad magic)");
   int32_t len = 0;
-  is.read(reinterpret_cast<char*>(&len), sizeof len);
-  if (!is || len < 0 || len > 64) throw std::runtime_error(source_name + ": truncated or corrupt model header");
+  if (!io::readPod(is, len) || len < 0 || len > 64) throw std::runtime_error(source_name + ": truncated or corrupt model header");
   std::string method(len, '\0');
   is.read(method.data(), len);
   if (method != methodName(config_.method))

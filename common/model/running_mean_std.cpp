@@ -6,6 +6,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "common/core/binary_io.hpp"
 #include "common/core/check.hpp"
 
 namespace masa::model {
@@ -129,26 +130,23 @@ void RunningMeanStd<S>::setMeanStd(const float* mean, const float* std) {
 template <typename S>
 void RunningMeanStd<S>::save(std::ostream& os) const {
   const int32_t d = dim_;
-  os.write(reinterpret_cast<const char*>(&d), sizeof d);
-  os.write(reinterpret_cast<const char*>(&count_), sizeof count_);
-  os.write(reinterpret_cast<const char*>(mean_.data()), sizeof(double) * dim_);
-  os.write(reinterpret_cast<const char*>(var_.data()), sizeof(double) * dim_);
+  io::writePod(os, d);
+  io::writePod(os, count_);
+  io::writeArray(os, mean_.data(), static_cast<std::size_t>(dim_));
+  io::writeArray(os, var_.data(), static_cast<std::size_t>(dim_));
 }
 
 template <typename S>
 void RunningMeanStd<S>::load(std::istream& is) {
   int32_t d = 0;
-  is.read(reinterpret_cast<char*>(&d), sizeof d);
-  if (!is) throw std::runtime_error("normalizer state is truncated");
+  if (!io::readPod(is, d)) throw std::runtime_error("normalizer state is truncated");
   if (d != dim_)
     throw std::runtime_error("normalizer state has dimension " + std::to_string(d) + ", expected " +
                              std::to_string(dim_));
   double count = 0;
   Eigen::VectorXd mean(dim_), var(dim_);
-  is.read(reinterpret_cast<char*>(&count), sizeof count);
-  is.read(reinterpret_cast<char*>(mean.data()), sizeof(double) * dim_);
-  is.read(reinterpret_cast<char*>(var.data()), sizeof(double) * dim_);
-  if (!is) throw std::runtime_error("normalizer state is truncated");
+  const auto n = static_cast<std::size_t>(dim_);
+  if (!io::readPod(is, count) || !io::readArray(is, mean.data(), n) || !io::readArray(is, var.data(), n)) throw std::runtime_error("normalizer state is truncated");
   count_ = count;
   mean_ = mean;
   var_ = var;

@@ -14,6 +14,7 @@
 #include <string>
 #include <utility>
 
+#include "common/core/binary_io.hpp"
 #include "common/core/check.hpp"
 
 namespace masa::nn {
@@ -21,14 +22,11 @@ namespace masa::nn {
 namespace {
 constexpr char kAdamMagic[8] = {'M', 'A', 'S', 'A', 'A', 'D', 'M', '1'};
 
-template <typename T>
-void writePod(std::ostream& os, const T& v) {
-  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
+using io::writeArray;
+using io::writePod;
 template <typename T>
 void readPod(std::istream& is, T& v, const char* what) {
-  if (!is.read(reinterpret_cast<char*>(&v), sizeof(T)))
-    throw std::runtime_error(std::string("Adam state: stream ends while reading ") + what);
+  if (!io::readPod(is, v)) throw std::runtime_error(std::string("Adam state: stream ends while reading ") + what);
 }
 }  // namespace
 
@@ -89,8 +87,8 @@ void Adam<S>::save(std::ostream& os) const {
   writePod(os, static_cast<std::uint32_t>(sizeof(S)));
   writePod(os, static_cast<std::int64_t>(m_.size()));
   writePod(os, static_cast<std::int64_t>(t_));
-  os.write(reinterpret_cast<const char*>(m_.data()), static_cast<std::streamsize>(m_.size() * sizeof(S)));
-  os.write(reinterpret_cast<const char*>(v_.data()), static_cast<std::streamsize>(v_.size() * sizeof(S)));
+  writeArray(os, m_.data(), static_cast<std::size_t>(m_.size()));
+  writeArray(os, v_.data(), static_cast<std::size_t>(v_.size()));
   if (!os) throw std::runtime_error("Adam state: write failed");
 }
 
@@ -113,8 +111,7 @@ void Adam<S>::load(std::istream& is) {
   if (t < 0) throw std::runtime_error("Adam state: negative step count " + std::to_string(t));
   // Read into temporaries so that a truncated stream leaves the optimizer as it was.
   Vec<S> m(n), v(n);
-  const auto bytes = static_cast<std::streamsize>(n * sizeof(S));
-  if (!is.read(reinterpret_cast<char*>(m.data()), bytes) || !is.read(reinterpret_cast<char*>(v.data()), bytes))
+  if (!io::readArray(is, m.data(), static_cast<std::size_t>(n)) || !io::readArray(is, v.data(), static_cast<std::size_t>(n)))
     throw std::runtime_error("Adam state: stream ends inside the moments");
   m_.swap(m);
   v_.swap(v);

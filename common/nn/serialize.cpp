@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "common/core/binary_io.hpp"
 #include "common/core/check.hpp"
 
 namespace masa::nn {
@@ -22,21 +23,19 @@ namespace {
 constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'P', 'A', 'R', '1'};
 constexpr std::uint32_t kMaxNameLength = 4096;  // longer means a corrupt or foreign file
 
-template <typename T>
-void writePod(std::ostream& os, const T& v) {
-  os.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
+using io::writePod;
 
 class Reader {
  public:
   Reader(std::istream& is, const std::string& source) : is_(is), source_(source) {}
-  void bytes(char* dst, std::size_t n, const std::string& what) {
-    if (!is_.read(dst, static_cast<std::streamsize>(n))) fail("file ends while reading " + what);
+  template <typename T>
+  void array(T* dst, std::size_t n, const std::string& what) {
+    if (!io::readArray(is_, dst, n)) fail("file ends while reading " + what);
   }
   template <typename T>
   T pod(const std::string& what) {
     T v;
-    bytes(reinterpret_cast<char*>(&v), sizeof(T), what);
+    if (!io::readPod(is_, v)) fail("file ends while reading " + what);
     return v;
   }
   [[noreturn]] void fail(const std::string& msg) const { throw std::runtime_error(source_ + ": " + msg); }
@@ -61,11 +60,11 @@ void saveParameters(const ParameterSet<S>& params, std::ostream& os) {
   writePod(os, static_cast<std::uint32_t>(params.segments().size()));
   for (const ParameterSegment& s : params.segments()) {
     writePod(os, static_cast<std::uint32_t>(s.name.size()));
-    os.write(s.name.data(), static_cast<std::streamsize>(s.name.size()));
+    io::writeArray(os, s.name.data(), s.name.size());
     writePod(os, static_cast<std::int32_t>(s.rows));
     writePod(os, static_cast<std::int32_t>(s.cols));
   }
-  os.write(reinterpret_cast<const char*>(params.values().data()), static_cast<std::streamsize>(params.size() * sizeof(S)));
+  io::writeArray(os, params.values().data(), static_cast<std::size_t>(params.size()));
   if (!os) throw std::runtime_error("saveParameters: write failed");
 }
 
@@ -74,7 +73,7 @@ void loadParameters(ParameterSet<S>& params, std::istream& is, const std::string
   MASA_CHECK(params.finalized(), "loadParameters needs a finalized parameter set");
   Reader in(is, source_name);
   char magic[sizeof(kMagic)];
-  in.bytes(magic, sizeof(magic), "the magic");
+  in.array(magic, sizeof(magic), "the magic");
   if (std::memcmp(magic, kMagic, sizeof(magic)) != 0) in.fail("not a masa parameter file (bad magic)");
   const auto scalar = in.pod<std::uint32_t>("the scalar type");
   if (scalar != sizeof(S))
@@ -88,7 +87,7 @@ void loadParameters(ParameterSet<S>& params, std::istream& is, const std::string
     const auto len = in.pod<std::uint32_t>("the name of segment " + idx);
     if (len > kMaxNameLength) in.fail("segment " + idx + " has a name of " + std::to_string(len) + " bytes (corrupt file)");
     std::string name(len, '\0');
-    in.bytes(name.data(), len, "the name of segment " + idx);
+    in.array(name.data(), len, "the name of segment " + idx);
     const auto rows = in.pod<std::int32_t>("the shape of segment " + idx);
     const auto cols = in.pod<std::int32_t>("the shape of segment " + idx);
     if (i >= segs.size())
@@ -106,7 +105,7 @@ void loadParameters(ParameterSet<S>& params, std::istream& is, const std::string
   }
   // Read into a temporary so that a truncated file leaves the model untouched.
   Vec<S> values(params.size());
-  in.bytes(reinterpret_cast<char*>(values.data()), static_cast<std::size_t>(params.size()) * sizeof(S), "the values");
+  in.array(values.data(), static_cast<std::size_t>(params.size()), "the values");
   params.values() = values;
 }
 

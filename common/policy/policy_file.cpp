@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/core/binary_io.hpp"
 #include "common/core/config_error.hpp"
 #include "common/model/equivariance_check.hpp"
 
@@ -23,14 +24,13 @@ constexpr uint64_t kMaxText = 16u << 20;  // a config or spec larger than this i
 
 void writeText(std::ostream& os, const std::string& s) {
   const uint64_t n = s.size();
-  os.write(reinterpret_cast<const char*>(&n), sizeof n);
+  io::writePod(os, n);
   os.write(s.data(), static_cast<std::streamsize>(n));
 }
 
 std::string readText(std::istream& is, const std::string& path, const char* what) {
   uint64_t n = 0;
-  is.read(reinterpret_cast<char*>(&n), sizeof n);
-  if (!is || n > kMaxText) throw std::runtime_error(path + ": truncated or corrupt policy file (" + what + ")");
+  if (!io::readPod(is, n) || n > kMaxText) throw std::runtime_error(path + ": truncated or corrupt policy file (" + what + ")");
   std::string s(n, '\0');
   is.read(s.data(), static_cast<std::streamsize>(n));
   if (!is) throw std::runtime_error(path + ": truncated policy file (" + what + ")");
@@ -54,7 +54,7 @@ void savePolicyFile(const std::string& path, const config::RunConfig& rc, const 
     std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
     if (!os) throw std::runtime_error(tmp + ": cannot write");
     os.write(kMagic, sizeof kMagic);
-    os.write(reinterpret_cast<const char*>(&kFormatVersion), sizeof kFormatVersion);
+    io::writePod(os, kFormatVersion);
     writeText(os, config::dumpResolved(rc));
     writeText(os, spec_text);
     model.save(os);
@@ -79,8 +79,7 @@ LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_
   if (!is || std::memcmp(magic, kMagic, sizeof magic) != 0)
     throw std::runtime_error(path + ": not a masa policy file (bad magic)");
   uint32_t version = 0;
-  is.read(reinterpret_cast<char*>(&version), sizeof version);
-  if (!is || version != kFormatVersion)
+  if (!io::readPod(is, version) || version != kFormatVersion)
     throw std::runtime_error(path + ": policy file format " + std::to_string(version) + ", this masa reads " +
                              std::to_string(kFormatVersion));
   LoadedPolicy p;
