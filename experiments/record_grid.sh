@@ -10,11 +10,12 @@
 #
 #   experiments/record_grid.sh --out runs/grid_ant --to experiments/results/ant_acrobatic_grid_2026-12-05
 #
-# --force replaces an existing --to folder. Refused while a grid runs in --out (its metrics would
-# move under the copy). MASA_BUILD_DIR chooses the build whose masa_compare redraws (default build).
+# --force replaces an existing --to folder, but for its README.md (what a person wrote about the
+# record is kept; the rest is the grid's, redrawn). Refused while a grid runs in --out (its
+# metrics would move under the copy). MASA_BUILD_DIR chooses the build whose masa_compare redraws (default build).
 set -euo pipefail
 
-usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
+usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
 out="" to="" force=0 policies=0 checkpoints=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -36,19 +37,30 @@ case "$out/" in "$(realpath -m "$to")"/*) echo "record_grid.sh: --to $to would h
 # Not while a grid runs there: its metrics would move under the copy. grid.sh --replot takes the
 # same lock, so a grid started after this check makes the redraw fail rather than the copy mix.
 ( flock -n 9 ) 9> "$out/.grid.lock" || { echo "record_grid.sh: a grid is running in $out; record it once it has stopped" >&2; exit 3; }
-if [ -e "$to" ]; then
-  [ "$force" = 1 ] || { echo "record_grid.sh: $to exists (--force replaces it)" >&2; exit 2; }
-  rm -rf "$to"
-fi
+[ ! -e "$to" ] || [ "$force" = 1 ] || { echo "record_grid.sh: $to exists (--force replaces it)" >&2; exit 2; }
 # The figures and the verdict of exactly these metrics.
 "$here/grid.sh" --replot --out "$out" > /dev/null || { echo "record_grid.sh: redrawing the comparison failed" >&2; exit 1; }
+kept_readme=""
+if [ -e "$to" ]; then
+  if [ -f "$to/README.md" ]; then
+    kept_readme=$(mktemp)
+    cp "$to/README.md" "$kept_readme"
+  fi
+  rm -rf "$to"
+fi
 
 mkdir -p "$to"
+if [ -n "$kept_readme" ]; then
+  cp "$kept_readme" "$to/README.md"
+  rm -f "$kept_readme"
+  echo "record_grid.sh: kept $to/README.md (written by hand: bring its figures up to date)"
+fi
 excludes=(--exclude=learning_curve.png --exclude=learning_curve.log
           --exclude=.grid.lock --exclude=.queue --exclude=.queue.lock --exclude=.slots)
 [ "$policies" = 1 ] || excludes+=(--exclude=policy.bin)
 [ "$checkpoints" = 1 ] || excludes+=(--exclude=checkpoint.bin --exclude=actor_state.bin)
 excludes+=(--exclude=actor_state.bin.tmp)
+[ -z "$kept_readme" ] || excludes+=(--exclude=./README.md)
 "$here/grid.sh" --status --out "$out" > "$to/status.txt"
 tar -C "$out" "${excludes[@]}" -cf - . | tar -C "$to" -xf -
 # A finished run's checkpoint would only serve grid.sh --extend: not worth its megabytes here.

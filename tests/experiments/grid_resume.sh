@@ -137,8 +137,13 @@ cp -a grid grid_old_logs && sed -i '/^masa_train: resumed at update/d' grid_old_
 grep -Eq "^  a1_beam/masa_s0: $rows_at_kill 150 \$" rec_old/RECORD.txt || fail "resumes from older logs: $(cat rec_old/RECORD.txt)"
 "$src/experiments/record_grid.sh" --out grid --to rec > rec2.out 2>&1 && fail "recording over an existing folder was accepted"
 grep -q "rec exists (--force replaces it)" rec2.out || fail "no reason given: $(cat rec2.out)"
+echo "what a person wrote about this record" > rec/README.md
+touch rec/stale_figure.png
 "$src/experiments/record_grid.sh" --out grid --to rec --force --policies > rec3.out 2>&1 || fail "--force failed: $(cat rec3.out)"
 [ -s rec/a1_beam/masa_s0/policy.bin ] || fail "--policies kept no policy"
+[ "$(cat rec/README.md)" = "what a person wrote about this record" ] && [ ! -e rec/stale_figure.png ] || \
+  fail "--force lost the record's README.md or kept the rest of the old folder"
+grep -q "kept rec/README.md" rec3.out || fail "--force did not say it kept the README: $(cat rec3.out)"
 exec 8> grid/.grid.lock
 flock -n 8 || fail "could not take the grid's lock"
 "$src/experiments/record_grid.sh" --out grid --to rec_running > rec4.out 2>&1 && fail "recording a running grid was accepted"
