@@ -76,22 +76,27 @@ void writeCsv(const std::string& path, const task::EvalSummary& s) {
   }
 }
 
-std::string frameLabel(const task::Task& task, int t) {
-  // Time and the task's progress figures on each frame.
-  char label[256];
-  int n = std::snprintf(label, sizeof label, "t %.2f s", (t + 1) * task.controlTimestep());
+// The caller's label (e.g. the method and seed, for strips compared side by side), the time and the
+// task's progress figures on each frame.
+std::string frameLabel(const std::string& prefix, const task::Task& task, int t) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "t %.2f s", (t + 1) * task.controlTimestep());
+  std::string label = prefix.empty() ? buf : prefix + "   " + buf;
   const auto names = task.progressNames();
   std::vector<double> values(names.size());
   if (!values.empty()) task.progress(values.data());
-  for (size_t i = 0; i < names.size() && n < static_cast<int>(sizeof label) - 40; ++i)
-    n += std::snprintf(label + n, sizeof label - n, "   %s %.2f", names[i].c_str(), values[i]);
+  for (size_t i = 0; i < names.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "   %.40s %.2f", names[i].c_str(), values[i]);
+    label += buf;
+  }
   return label;
 }
 
 // Films one episode (replayed alone from its seed). A .png strip shows `strip` frames spread
 // evenly over the whole episode, however short (render::StripSampler).
 void film(const task::TaskFactory& factory, model::ActorCritic<float>& model, task::EvalOptions o, uint64_t seed,
-          const std::string& video, int width, int height, int strip, double fps, double camera_distance) {
+          const std::string& video, const std::string& label, int width, int height, int strip, double fps,
+          double camera_distance) {
   o.episodes = 1;
   o.seed = seed;
   o.threads = 1;
@@ -109,10 +114,10 @@ void film(const task::TaskFactory& factory, model::ActorCritic<float>& model, ta
   int frames = 0;
   task::PolicyEvaluator(factory, model).run(o, [&](int, int t, const task::Task& task, bool last) {
     if (is_strip) {
-      if (sampler.wants(t)) sampler.add(t, renderer.render(task.data(), frameLabel(task, t)));
-      else if (last) sampler.addLast(t, renderer.render(task.data(), frameLabel(task, t)));
+      if (sampler.wants(t)) sampler.add(t, renderer.render(task.data(), frameLabel(label, task, t)));
+      else if (last) sampler.addLast(t, renderer.render(task.data(), frameLabel(label, task, t)));
     } else if (t % every == 0) {
-      writer->write(renderer.render(task.data(), frameLabel(task, t)));
+      writer->write(renderer.render(task.data(), frameLabel(label, task, t)));
       ++frames;
     }
   });
@@ -126,7 +131,7 @@ void film(const task::TaskFactory& factory, model::ActorCritic<float>& model, ta
 int main(int argc, char** argv) {
   CLI::App app{"Evaluate a trained masa policy in its task (return, progress, success, reward terms)"};
   app.set_version_flag("--version", masa::buildCommit());
-  std::string target, video, csv, save_policy;
+  std::string target, video, csv, save_policy, label;
   std::vector<std::string> overrides;
   task::EvalOptions o;
   bool sample = false, per_episode = false;
@@ -146,6 +151,7 @@ int main(int argc, char** argv) {
   app.add_option("--save-policy", save_policy, "also write the target as a policy file (e.g. from a checkpoint, to ship it)");
   app.add_option("--video", video, "film one episode: .mp4, .gif, or .png (an image strip); needs a display or xvfb-run");
   app.add_option("--film-episode", film_episode, "which episode to film (its seed is seed + this)")->capture_default_str();
+  app.add_option("--label", label, "text at the start of every filmed frame's caption (e.g. the method and seed)");
   app.add_option("--strip-frames", strip, "frames in a .png strip")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--fps", fps, "video frame rate")->capture_default_str();
   app.add_option("--width", width, "video width")->capture_default_str();
@@ -185,8 +191,8 @@ int main(int argc, char** argv) {
     }
     if (!video.empty()) {
       if (film_episode < 0 || film_episode >= o.episodes) throw std::runtime_error("--film-episode must be one of the episodes");
-      film(factory, *p.model, o, o.seed + static_cast<uint64_t>(film_episode), video, width, height, strip, fps,
-           camera_distance);
+      film(factory, *p.model, o, o.seed + static_cast<uint64_t>(film_episode), video, label, width, height, strip,
+           fps, camera_distance);
     }
   } catch (const ConfigError& e) {
     std::cerr << "masa_eval: " << e.what() << "\n";

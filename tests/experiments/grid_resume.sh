@@ -154,6 +154,24 @@ grep -q "is not a grid" rec5.out || fail "no reason given: $(cat rec5.out)"
 "$src/experiments/record_grid.sh" --out grid --to . --force > rec6.out 2>&1 && fail "recording over the grid's parent was accepted"
 grep -q "would hold or replace the grid itself" rec6.out && [ -d grid/a1_beam ] || fail "no reason given: $(cat rec6.out)"
 
+# 3d. film_grid.sh: each method's policy of one seed in the same episode, one strip a row, stacked;
+# refused for a seed no run has, a task the grid has not, a folder that is no grid.
+"$src/experiments/film_grid.sh" --out grid --seed 0 --frames 4 --width 160 --height 120 > film.out 2>&1 || \
+  fail "film_grid.sh failed: $(cat film.out)"
+for m in masa sa; do
+  grep -Eq "^$m seed 0 \(160 updates\): return -?[0-9.]+, length [0-9]+, (terminated|time limit)" film.out || \
+    fail "film_grid.sh did not report $m's episode: $(cat film.out)"
+done
+size=$(ffprobe -v error -select_streams v:0 -show_entries stream=width,height -of csv=p=0 grid/a1_beam/film_s0.png) || \
+  fail "no grid/a1_beam/film_s0.png"
+[ "$size" = "640,240" ] || fail "the film is $size pixels, not 4 frames of 160 wide by 2 rows of 120"
+"$src/experiments/film_grid.sh" --out grid --seed 1 > film2.out 2>&1 && fail "a seed without runs was filmed"
+grep -q "no method of seed 1 has a policy or checkpoint" film2.out || fail "no reason given: $(cat film2.out)"
+"$src/experiments/film_grid.sh" --out grid --seed 0 --task ant_acrobatic > film3.out 2>&1 && fail "a task not in the grid was filmed"
+grep -q "the grid has no task 'ant_acrobatic'" film3.out || fail "no reason given: $(cat film3.out)"
+"$src/experiments/film_grid.sh" --out grid/a1_beam --seed 0 > film4.out 2>&1 && fail "a folder without grid.txt was filmed"
+grep -q "is not a grid" film4.out || fail "no reason given: $(cat film4.out)"
+
 # 4. Over a hosts file: every run goes through MASA_SSH and its directory through MASA_RSYNC (here
 # stand-ins that run on this machine and log what they were asked to do).
 cat > fake_ssh.sh <<'SH'
@@ -195,4 +213,4 @@ grep -q "0 runs finished, 0 go on from their checkpoints, 1 start afresh" restor
 grep -q "restored exists" restore3.out || fail "no reason given: $(cat restore3.out)"
 "$src/experiments/restore_grid.sh" --from rec_stopped/a1_beam --out restored4 > restore4.out 2>&1 && fail "restoring a non-grid was accepted"
 grep -q "is not a recorded grid" restore4.out && [ ! -e restored4 ] || fail "no reason given: $(cat restore4.out)"
-echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, recorded, hosts file used, restored from its record"
+echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, recorded, filmed, hosts file used, restored from its record"
