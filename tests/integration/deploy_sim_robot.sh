@@ -85,16 +85,20 @@ walk|walk_tuned)
 faults)
   steps=250
   # Real time on a shared machine: a runner not scheduled for 50 ms trips its watchdog (stale
-  # state), which is the watchdog doing its job, not the faults under test. Such a run is said
-  # and tried once more; any other failure, or a second trip, fails.
+  # state), which is the watchdog doing its job, not the faults under test. The runner then exits
+  # (--exit-on-trip: a tripped runner holds the safe command and would never reach its policy
+  # steps), the robot is stopped, and the run is said and tried once more; any other trip or
+  # failure, or a second trip, fails.
   for attempt in 1 2; do
     "$sim" "$policy" --seed 0 --duration 6.5 --quiet --delay-ms 4 --jitter-ms 4 --loss 0.05 --fault-seed 1 \
       > "$work/sim.log" 2>&1 & pids+=($!)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps $steps --quiet > "$work/deploy.log" 2>&1
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps $steps --exit-on-trip --quiet \
+      > "$work/deploy.log" 2>&1
     rc=$?
+    [ $rc -eq 4 ] && kill -INT "${pids[-1]}" 2> /dev/null
     wait "${pids[-1]}"
-    [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
-    trip=$(grep -m1 -o "watchdog: no new state[^)]*" "$work/deploy.log") || break
+    [ $rc -eq 0 ] && ! grep -q ": \(watchdog\|emergency stop\):" "$work/deploy.log" && break
+    trip=$(grep -m1 -o "watchdog: no new state[^)]*)" "$work/deploy.log") || fail "masa_deploy exited with $rc"
     [ $attempt -eq 1 ] || fail "the watchdog tripped twice: $trip"
     echo "attempt 1: $trip (scheduling on a loaded machine?); trying again"
   done
