@@ -16,6 +16,9 @@
 #                 into configs/deploy/a1_beam_sim.yaml's crouch pose, targets no faster than its rate
 #   refusals      the shipped TriFinger Lift, Ant Acrobatic and Humanoid Dribbling policies are
 #                 refused with their configs, naming the object the robot cannot measure
+# A real-time runner on a loaded machine can miss its state for 50 ms and trip its watchdog, which is
+# the watchdog doing its job, not what these cases test: walk, walk_tuned, faults and crouch say
+# such a run and try it once more; a second trip fails.
 # Prints "PASS: ..." or "FAIL: ...".
 set -uo pipefail
 case_name=$1
@@ -53,13 +56,23 @@ le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a <= b) }'; }
 drive() {
   local robot=$1 steps=$2 seconds=$3
   shift 3
-  "$sim" "$policy" --seed 0 --duration "$seconds" --quiet > "$work/sim.log" 2>&1 & pids+=($!)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" "$@" --max-policy-steps "$steps" --quiet > "$work/deploy.log" 2>&1
-  local rc=$?
-  wait "${pids[0]}"
-  [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
-  local trip
-  trip=$(grep -m1 -E ": (watchdog|emergency stop):" "$work/deploy.log") && fail "the runner tripped: $trip"
+  # A watchdog trip for stale state on a loaded machine is said and tried once more (see faults).
+  local attempt rc trip
+  for attempt in 1 2; do
+    "$sim" "$policy" --seed 0 --duration "$seconds" --quiet > "$work/sim.log" 2>&1 & pids+=($!)
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" "$@" --max-policy-steps "$steps" --exit-on-trip --quiet \
+      > "$work/deploy.log" 2>&1
+    rc=$?
+    [ $rc -eq 4 ] && kill -INT "${pids[-1]}" 2> /dev/null
+    wait "${pids[-1]}"
+    [ $rc -eq 0 ] && ! grep -q -E ": (watchdog|emergency stop):" "$work/deploy.log" && break
+    trip=$(grep -m1 -o "watchdog: no new state[^)]*)" "$work/deploy.log") || {
+      trip=$(grep -m1 -E ": (watchdog|emergency stop):" "$work/deploy.log") && fail "the runner tripped: $trip"
+      fail "masa_deploy exited with $rc"
+    }
+    [ $attempt -eq 1 ] || fail "the watchdog tripped twice: $trip"
+    echo "attempt 1: $trip (scheduling on a loaded machine?); trying again"
+  done
   "$eval_bin" "$policy" --episodes 1 --seed 0 --max-steps "$steps" > "$work/eval.log" 2>&1 || fail "masa_eval failed"
   local line
   line=$(grep "policy phase" "$work/sim.log") || fail "the simulated robot saw no policy phase"
@@ -157,11 +170,19 @@ humanoid)
   echo "PASS: the humanoid lunged $walked m along the rope over LCM (masa_eval: $evaluated m)"
   ;;
 crouch)
-  "$sim" "$policy" --seed 0 --duration 4 --quiet --tilt-state-after 1.0 --tilt-rad 1.0 > "$work/sim.log" 2>&1 & pids+=($!)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 3.8 --quiet > "$work/deploy.log" 2>&1
-  rc=$?
-  wait "${pids[0]}"
-  [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
+  # The roll must be what stops the runner: a watchdog trip for stale state before it (a runner not
+  # scheduled for 50 ms on a loaded machine) latches the damping command instead; such a run is
+  # said and tried once more.
+  for attempt in 1 2; do
+    "$sim" "$policy" --seed 0 --duration 4 --quiet --tilt-state-after 1.0 --tilt-rad 1.0 > "$work/sim.log" 2>&1 & pids+=($!)
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 3.8 --quiet > "$work/deploy.log" 2>&1
+    rc=$?
+    wait "${pids[-1]}"
+    [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
+    trip=$(grep -m1 -o "watchdog: no new state[^)]*)" "$work/deploy.log") || break
+    [ $attempt -eq 1 ] || fail "the watchdog tripped twice: $trip"
+    echo "attempt 1: $trip (scheduling on a loaded machine?); trying again"
+  done
   grep -q "emergency stop: roll" "$work/deploy.log" || fail "masa_deploy did not stop on the roll"
   grep -q "first safe command (mode 4)" "$work/sim.log" || fail "the robot got no emergency-stop command"
   rate=$(sed -nE 's/.*emergency-stop commands: ([0-9.]+) rad\/s.*/\1/p' "$work/sim.log")
