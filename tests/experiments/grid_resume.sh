@@ -156,6 +156,7 @@ grep -q "would hold or replace the grid itself" rec6.out && [ -d grid/a1_beam ] 
 
 # 3d. film_grid.sh: each method's policy of one seed in the same episode, one strip a row, stacked;
 # refused for a seed no run has, a task the grid has not, a folder that is no grid.
+command -v xvfb-run > /dev/null || fail "xvfb-run is missing (scripts/install_deps.sh installs it)"
 "$src/experiments/film_grid.sh" --out grid --seed 0 --frames 4 --width 160 --height 120 > film.out 2>&1 || \
   fail "film_grid.sh failed: $(cat film.out)"
 for m in masa sa; do
