@@ -47,7 +47,7 @@ wall=$(tail -n 1 "$run/metrics.csv" | cut -d, -f4)
   echo "Trained $(date -r "$run/metrics.csv" +%Y-%m-%d) by commit ${commit:0:7} on $(nproc --all) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')):"
   echo "$((updates + 1)) updates, $steps env steps, $(printf %.0f "$wall") s of training wall time. Run configuration: \`config.yaml\`."
   if [ -f "$run.log" ]; then
-    echo "The command (from the run's log): \`$(grep -m1 -o 'masa_train .*' "$run.log" | sed 's/ --run-dir [^ ]*//')\`."
+    echo "The command (from the run's log): \`$(grep -m1 -o 'masa_train .*' "$run.log" | sed 's/ --run-dir [^ ]*//; s/ *$//')\`."
   fi
   echo
   echo '```bash'
