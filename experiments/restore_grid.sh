@@ -32,6 +32,12 @@ tasks=$(field tasks) methods=$(field methods) seeds=$(field seeds)
 mkdir -p "$out"
 # What describes the record, not the grid, stays behind.
 tar -C "$from" --exclude=./RECORD.txt --exclude=./README.md --exclude=./status.txt -cf - . | tar -C "$out" -xf -
+# record_grid.sh keeps the environments compressed; xz checks its own integrity while unpacking.
+# (-exec +: find fails when xz does; the half-made grid goes, $out did not exist before)
+find "$out" -mindepth 3 -maxdepth 3 -name actor_state.bin.xz -exec xz -d {} + || {
+  rm -rf "$out"
+  echo "restore_grid.sh: unpacking a run's environments (actor_state.bin.xz) failed; nothing restored" >&2; exit 1
+}
 
 finished=0 going_on=0 afresh=0
 for t in $tasks; do for m in $methods; do for s in $seeds; do

@@ -19,6 +19,8 @@ packages=(
   libssl-dev
   # tests and benchmarks (iproute2 and nftables: the multi-host tests over network namespaces)
   libgtest-dev libgmock-dev libbenchmark-dev iproute2 nftables
+  # experiment records (record_grid.sh keeps a grid's environments xz-compressed)
+  xz-utils
   # actors on other machines (deploy/train.sh --hosts)
   openssh-client
   # offscreen rendering of rollouts

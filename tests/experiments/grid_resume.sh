@@ -52,8 +52,11 @@ grep -Eq "^0 done, 0 running, 1 stopped, 1 waiting; $rows_at_kill of 300 updates
 # keeps when its machine goes), and without.
 "$src/experiments/record_grid.sh" --out grid --to rec_stopped --checkpoints > rec_stopped.out 2>&1 || \
   fail "record_grid.sh --checkpoints failed: $(cat rec_stopped.out)"
-[ -s rec_stopped/a1_beam/masa_s0/checkpoint.bin ] && [ -s rec_stopped/a1_beam/masa_s0/actor_state.bin ] || \
-  fail "--checkpoints did not keep the stopped run's checkpoint and environments"
+[ -s rec_stopped/a1_beam/masa_s0/checkpoint.bin ] && [ -s rec_stopped/a1_beam/masa_s0/actor_state.bin.xz ] || \
+  fail "--checkpoints did not keep the stopped run's checkpoint and its environments, compressed"
+[ ! -e rec_stopped/a1_beam/masa_s0/actor_state.bin ] || fail "the environments were kept uncompressed as well"
+cmp -s <(xz -dc rec_stopped/a1_beam/masa_s0/actor_state.bin.xz) grid/a1_beam/masa_s0/actor_state.bin || \
+  fail "the recorded environments are not the stopped run's"
 grep -q "^checkpoints: 1 unfinished runs keep theirs" rec_stopped/RECORD.txt || fail "RECORD.txt: $(cat rec_stopped/RECORD.txt)"
 "$src/experiments/record_grid.sh" --out grid --to rec_stopped_plain > rec_stopped_plain.out 2>&1 || \
   fail "record_grid.sh of the stopped grid failed: $(cat rec_stopped_plain.out)"
@@ -199,6 +202,8 @@ grep -q "^rsync -a far-host:$PWD/remote/a1_beam/masa_s0/ $PWD/remote/a1_beam/mas
 grep -q "0 runs finished, 1 go on from their checkpoints, 0 start afresh" restore.out || fail "restore said: $(cat restore.out)"
 grep -q "^# restored .* from rec_stopped at commit .*: 0 finished, 1 go on" restored/grid.txt || fail "grid.txt: $(cat restored/grid.txt)"
 [ ! -e restored/RECORD.txt ] && [ ! -e restored/status.txt ] || fail "the record's own files came along"
+cmp -s <(xz -dc rec_stopped/a1_beam/masa_s0/actor_state.bin.xz) restored/a1_beam/masa_s0/actor_state.bin && \
+  [ ! -e restored/a1_beam/masa_s0/actor_state.bin.xz ] || fail "restore_grid.sh did not unpack the environments"
 "$src/experiments/grid.sh" --out restored > grid7.out 2>&1 || fail "the restored grid failed: $(cat grid7.out)"
 grep -q "^masa_train: resumed at update $rows_at_kill (.*); the environments go on as they were" restored/a1_beam/masa_s0.log || \
   fail "the restored masa run did not go on from $rows_at_kill with its environments: $(grep resumed restored/a1_beam/masa_s0.log)"
@@ -214,4 +219,10 @@ grep -q "0 runs finished, 0 go on from their checkpoints, 1 start afresh" restor
 grep -q "restored exists" restore3.out || fail "no reason given: $(cat restore3.out)"
 "$src/experiments/restore_grid.sh" --from rec_stopped/a1_beam --out restored4 > restore4.out 2>&1 && fail "restoring a non-grid was accepted"
 grep -q "is not a recorded grid" restore4.out && [ ! -e restored4 ] || fail "no reason given: $(cat restore4.out)"
+# A damaged environments file in the record is refused by name, not resumed from.
+cp -r rec_stopped rec_damaged
+head -c 1000 rec_stopped/a1_beam/masa_s0/actor_state.bin.xz > rec_damaged/a1_beam/masa_s0/actor_state.bin.xz
+"$src/experiments/restore_grid.sh" --from rec_damaged --out restored5 > restore5.out 2>&1 && fail "a damaged record was restored"
+grep -q "unpacking a run's environments (actor_state.bin.xz) failed; nothing restored" restore5.out && [ ! -e restored5 ] || \
+  fail "damaged record: $(cat restore5.out)"
 echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, recorded, filmed, hosts file used, restored from its record"
