@@ -176,6 +176,34 @@ grep -q "the grid has no task 'ant_acrobatic'" film3.out || fail "no reason give
 "$src/experiments/film_grid.sh" --out grid/a1_beam --seed 0 > film4.out 2>&1 && fail "a folder without grid.txt was filmed"
 grep -q "is not a grid" film4.out || fail "no reason given: $(cat film4.out)"
 
+# 3e. compare_runs.sh: any runs under labels of one's own (variants, runs of several grids), cut at
+# a common budget, through masa_compare; refusals change nothing.
+"$src/experiments/compare_runs.sh" --out cmp --updates 100 --reference b a=grid/a1_beam/sa_s0 b=grid/a1_beam/masa_s0 \
+  > cmp.out 2>&1 || fail "compare_runs.sh failed: $(cat cmp.out)"
+for l in a b; do
+  [ "$(wc -l < cmp/a1_beam/${l}_s0/metrics.csv)" = 101 ] && [ -f cmp/a1_beam/${l}_s0/done ] || \
+    fail "cmp/a1_beam/${l}_s0: not the first 100 updates, or not marked done"
+done
+cmp -s cmp/a1_beam/b_s0/metrics.csv <(head -n 101 grid/a1_beam/masa_s0/metrics.csv) || fail "b_s0 is not masa_s0's first 100 updates"
+[ -s cmp/a1_beam/compare.png ] && grep -q "^# Comparison: b against each baseline" cmp/verdict.md || fail "no figure or verdict: $(cat cmp.out)"
+grep -q "^methods=a b$" cmp/grid.txt && grep -q "^b 0 a1_beam 100 $PWD/grid/a1_beam/masa_s0$" cmp/sources.txt || \
+  fail "sources: $(cat cmp/grid.txt cmp/sources.txt)"
+"$src/experiments/compare_runs.sh" --out cmp2 --updates 999 a=grid/a1_beam/sa_s0 b=grid/a1_beam/masa_s0 > cmp2.out 2>&1 || \
+  fail "compare_runs.sh with runs short of the budget failed: $(cat cmp2.out)"
+grep -q "fewer than 999 updates, kept as unfinished: a_s0 (160 updates) b_s0 (160 updates)" cmp2.out && \
+  [ ! -e cmp2/a1_beam/a_s0/done ] || fail "short runs not named unfinished: $(cat cmp2.out)"
+refuse() {  # expected message, then the arguments
+  local want=$1; shift
+  "$src/experiments/compare_runs.sh" "$@" > refused.out 2>&1 && fail "compare_runs.sh $* was accepted"
+  grep -q -- "$want" refused.out && [ ! -e cmp3 ] || fail "compare_runs.sh $*: no reason given, or it wrote: $(cat refused.out)"
+}
+refuse "cmp exists (--force replaces it)" --out cmp a=grid/a1_beam/sa_s0 b=grid/a1_beam/masa_s0
+refuse "a has two runs of a1_beam with seed 0" --out cmp3 a=grid/a1_beam/sa_s0 a=grid/a1_beam/masa_s0 b=grid/a1_beam/sa_s0
+refuse "label 'a_b'" --out cmp3 a_b=grid/a1_beam/sa_s0 b=grid/a1_beam/masa_s0
+refuse "is not a run directory" --out cmp3 a=grid/a1_beam b=grid/a1_beam/masa_s0
+refuse "--reference c is none of the labels (a b)" --out cmp3 --reference c a=grid/a1_beam/sa_s0 b=grid/a1_beam/masa_s0
+refuse "give at least two LABEL=RUN_DIR (got 1)" --out cmp3 a=grid/a1_beam/sa_s0
+
 # 4. Over a hosts file: every run goes through MASA_SSH and its directory through MASA_RSYNC (here
 # stand-ins that run on this machine and log what they were asked to do).
 cat > fake_ssh.sh <<'SH'
