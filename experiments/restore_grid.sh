@@ -5,8 +5,8 @@
 # --checkpoints) goes on from it; the rest start afresh, their partial metrics and logs dropped.
 # grid.txt says what was restored from where, and RECORD.txt of the next record lists it.
 #
-#   experiments/restore_grid.sh --from experiments/results/ant_acrobatic_grid_recipe_in_progress --out runs/grid_ant_recipe
-#   experiments/grid.sh --out runs/grid_ant_recipe                    (then go on)
+#   experiments/restore_grid.sh --from experiments/results/a1_beam_grid_recipe_in_progress --out runs/grid_a1_recipe
+#   experiments/grid.sh --out runs/grid_a1_recipe                      (then go on)
 #
 # Refused when --out exists (a grid there has newer metrics than any record).
 set -euo pipefail
