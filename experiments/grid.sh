@@ -6,6 +6,7 @@
 #       [--updates N] [--no-recipe] [--jobs N] [--threads T] [--hosts FILE] [--out DIR] [--set key=value ...]
 #   experiments/grid.sh --replot --out DIR      (only the comparison of an existing grid)
 #   experiments/grid.sh --extend N --out DIR    (the grid's runs go on to N updates each)
+#   experiments/grid.sh --out DIR --seeds "0 ... 9"  (more seeds, methods or tasks: the grid grows)
 #   experiments/grid.sh --status --out DIR      (each run's progress and the grid's ETA)
 # Resumable: run the same command again (or with --out DIR) after a kill. A finished run (its
 # `done` file) is not redone, a run with a checkpoint goes on from it, the rest start afresh.
@@ -26,7 +27,7 @@ repo=$(pwd)
 # --out and --hosts are the caller's paths; MASA_BUILD_DIR is relative to the checkout.
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
 
-tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1 extend=""
+tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1 extend="" grown=()
 status=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -43,7 +44,7 @@ while [ $# -gt 0 ]; do
     --replot) replot=1; shift ;;
     --extend) extend=$2; shift 2 ;;
     --status) status=1; shift ;;
-    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -79,16 +80,25 @@ if [ -n "$out" ] && [ -f "$out/grid.txt" ]; then
   g_tasks=$(sed -n 's/^tasks=//p' <<< "$saved"); g_methods=$(sed -n 's/^methods=//p' <<< "$saved")
   g_seeds=$(sed -n 's/^seeds=//p' <<< "$saved"); g_updates=$(sed -n 's/^updates=//p' <<< "$saved")
   g_recipe=$(sed -n 's/^recipe=//p' <<< "$saved"); g_sets=$(sed -n 's/^set=//p' <<< "$saved")
+  # Naming all the grid has and more (seeds, methods, tasks) grows it: its runs stay, the new ones
+  # join the queue. Anything else that differs is another grid.
   for k in tasks methods seeds updates; do
     want=${!k}; have=$(eval echo "\$g_$k")
-    if [ -n "$want" ] && [ "$want" != "$have" ]; then
-      echo "grid.sh: $out is the grid $k='$have', not '$want' (use another --out)" >&2; exit 2
+    { [ -z "$want" ] || [ "$want" = "$have" ]; } && continue
+    words() { tr -s ' ' '\n' <<< "$1" | sed '/^$/d' | sort -u; }
+    if [ "$k" != updates ] && [ -z "$(comm -23 <(words "$have") <(words "$want"))" ]; then
+      grown+=("$k '$have' -> '$want'"); continue
     fi
+    echo "grid.sh: $out is the grid $k='$have', not '$want' (use another --out; to grow it, name all it has and more)" >&2
+    exit 2
   done
+  if [ ${#grown[@]} -gt 0 ] && { [ "$replot" = 1 ] || [ "$status" = 1 ]; }; then
+    echo "grid.sh: --replot and --status take the grid as it is; growing it (${grown[*]}) runs the new runs" >&2; exit 2
+  fi
   if [ ${#sets[@]} -gt 0 ] && [ "$(printf '%s\n' "${sets[@]}")" != "$g_sets" ]; then
     echo "grid.sh: $out was made with other --set options:"$'\n'"$g_sets" >&2; exit 2
   fi
-  tasks=$g_tasks methods=$g_methods seeds=$g_seeds updates=$g_updates recipe=$g_recipe
+  tasks=${tasks:-$g_tasks} methods=${methods:-$g_methods} seeds=${seeds:-$g_seeds} updates=$g_updates recipe=$g_recipe
   mapfile -t sets < <(printf '%s' "$g_sets" | sed '/^$/d')
 elif [ "$replot" = 1 ] || [ "$status" = 1 ]; then
   echo "grid.sh: --replot and --status need --out with an existing grid (its grid.txt)" >&2; exit 2
@@ -178,6 +188,12 @@ if [ -z "$extend" ]; then
     echo "grid.sh: another grid is running in $out (wait for it, or stop it first)" >&2
     exit 3
   fi
+fi
+# A grid that grows writes its new definition only under the lock: a running grid's never changes.
+if [ ${#grown[@]} -gt 0 ]; then
+  for k in tasks methods seeds; do sed -i "s/^$k=.*/$k=${!k}/" "$out/grid.txt"; done
+  echo "# grew: ${grown[*]} $(date -u +%FT%TZ) at commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)" >> "$out/grid.txt"
+  echo "grid.sh: $out grows: ${grown[*]}"
 fi
 
 if [ "$replot" = 0 ]; then

@@ -93,8 +93,8 @@ grep -q "2 already done" grid3.out || fail "the third call did not see both runs
 [ -s grid/verdict.md ] || fail "the third call did not redo the comparison"
 # --replot, and a grid definition that differs from the directory's is refused.
 "$src/experiments/grid.sh" --replot --out grid > grid4.out 2>&1 || fail "--replot failed"
-"$src/experiments/grid.sh" --out grid --seeds "0 1" > grid5.out 2>&1 && fail "a different grid in the same directory was accepted"
-grep -q "is the grid seeds='0', not '0 1'" grid5.out || fail "the refusal does not say why: $(cat grid5.out)"
+"$src/experiments/grid.sh" --out grid --seeds 1 > grid5.out 2>&1 && fail "a different grid in the same directory was accepted"
+grep -q "is the grid seeds='0', not '1'" grid5.out || fail "the refusal does not say why: $(cat grid5.out)"
 # 3b. --extend: the finished grid goes on to 160 updates, both runs from their checkpoints at 150;
 # fewer updates, or other grid options with it, are refused with the reason.
 "$src/experiments/grid.sh" --extend 150 --out grid > grid_ext0.out 2>&1 && fail "--extend to the grid's own 150 updates was accepted"
@@ -112,6 +112,26 @@ for m in masa sa; do
     fail "$m's epochs are not 0..159 in order"
 done
 [ -s grid/verdict.md ] || fail "the extended grid did not redo the comparison"
+
+# 3b'. A grid grows (a copy of it, here): naming its seed and one more runs the new seed's runs
+# with the grid's options and updates, redoes none of seed 0's, and compares over both seeds.
+# Growing with --replot, or with other --set options, is refused and changes nothing.
+cp -a grid grown
+"$src/experiments/grid.sh" --replot --seeds "0 1" --out grown > grow0.out 2>&1 && fail "--replot grew the grid"
+grep -q "take the grid as it is" grow0.out || fail "no reason given: $(cat grow0.out)"
+"$src/experiments/grid.sh" --seeds "0 1" --set ppo.num_envs=16 --out grown > grow1.out 2>&1 && fail "a grid grew with other --set options"
+grep -q "^seeds=0$" grown/grid.txt || fail "a refused growth changed grid.txt"
+logs_before=$(cat grown/a1_beam/*_s0.log | wc -l)
+"$src/experiments/grid.sh" --seeds "0 1" --out grown > grow.out 2>&1 || fail "growing the grid failed: $(cat grow.out)"
+grep -q "grows: seeds '0' -> '0 1'" grow.out && grep -q "4 runs .*, 2 already done" grow.out || fail "growing did not say what it did"
+grep -q "^seeds=0 1$" grown/grid.txt && grep -q "^# grew: seeds '0' -> '0 1'" grown/grid.txt || fail "grid.txt does not record the growth"
+[ "$(cat grown/a1_beam/*_s0.log | wc -l)" -eq "$logs_before" ] || fail "growing ran seed 0 again"
+for m in masa sa; do
+  [ -f "grown/a1_beam/${m}_s1/done" ] || fail "the new $m seed is not done"
+  [ "$(($(wc -l < "grown/a1_beam/${m}_s1/metrics.csv") - 1))" -eq 160 ] || fail "the new $m seed did not run the grid's 160 updates"
+  grep -q "num_envs: 8" "grown/a1_beam/${m}_s1/config.yaml" || fail "the new $m seed lost the grid's --set options"
+done
+grep -q "^| masa | 2 |" grown/verdict.md || fail "the grown grid's comparison is not over both seeds: $(cat grown/verdict.md)"
 
 # 3c. record_grid.sh: the grid as experiments/results/ keeps it (redrawn, no checkpoints, policies
 # or per-run PNGs, with RECORD.txt); refused over an existing folder, while a grid runs, for a
