@@ -64,6 +64,14 @@ if [ -n "$extend" ]; then
   have=$(sed -n 's/^updates=//p' "$out/grid.txt")
   [ -n "$have" ] || { echo "grid.sh: $out's runs follow each recipe's ppo.max_epochs (no --updates); --extend needs a number to go on from" >&2; exit 2; }
   [ "$extend" -gt "$have" ] || { echo "grid.sh: $out's runs already go to $have updates; --extend $extend must be more" >&2; exit 2; }
+  # A finished run goes on only from its checkpoint; without one (a record made without them) it
+  # would start afresh and lose its updates, so the extension is refused before anything changes.
+  bare=$(find "$out" -mindepth 3 -maxdepth 3 -name done -printf '%h\n' | sort | while read -r d; do
+           [ -f "$d/checkpoint.bin" ] || echo "${d#"$out"/}"; done)
+  if [ -n "$bare" ]; then
+    echo "grid.sh: --extend needs each finished run's checkpoint, and these have none: $(echo $bare)" \
+         "(a record keeps them with record_grid.sh --all-checkpoints)" >&2; exit 2
+  fi
   exec {grid_lock}> "$out/.grid.lock"
   flock -n "$grid_lock" || { echo "grid.sh: another grid is running in $out (wait for it, or stop it first)" >&2; exit 3; }
   sed -i "s/^updates=.*/updates=$extend/" "$out/grid.txt"

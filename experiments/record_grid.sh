@@ -7,7 +7,8 @@
 # --checkpoints keeps the checkpoints of the runs not yet finished (with their environments,
 # actor_state.bin, kept xz-compressed as actor_state.bin.xz: 4.2 MB -> 1.9 MB for the Ant recipe),
 # so that restore_grid.sh can bring the grid back on another machine (or in a later session, whose
-# machine is new) and go on.
+# machine is new) and go on. --all-checkpoints keeps the finished runs' too, for a grid to be
+# extended (grid.sh --extend) elsewhere: 3.3 MB a run for the Ant recipe.
 #
 #   experiments/record_grid.sh --out runs/grid_ant --to experiments/results/ant_acrobatic_grid_2026-12-05
 #
@@ -16,7 +17,7 @@
 # metrics would move under the copy). MASA_BUILD_DIR chooses the build whose masa_compare redraws (default build).
 set -euo pipefail
 
-usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
+usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
 out="" to="" force=0 policies=0 checkpoints=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -25,6 +26,7 @@ while [ $# -gt 0 ]; do
     --force) force=1; shift ;;
     --policies) policies=1; shift ;;
     --checkpoints) checkpoints=1; shift ;;
+    --all-checkpoints) checkpoints=2; shift ;;
     -h|--help) usage ;;
     *) echo "record_grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -59,15 +61,15 @@ fi
 excludes=(--exclude=learning_curve.png --exclude=learning_curve.log
           --exclude=.grid.lock --exclude=.queue --exclude=.queue.lock --exclude=.slots)
 [ "$policies" = 1 ] || excludes+=(--exclude=policy.bin)
-[ "$checkpoints" = 1 ] || excludes+=(--exclude=checkpoint.bin --exclude=actor_state.bin)
+[ "$checkpoints" -ge 1 ] || excludes+=(--exclude=checkpoint.bin --exclude=actor_state.bin)
 excludes+=(--exclude=actor_state.bin.tmp)
 [ -z "$kept_readme" ] || excludes+=(--exclude=./README.md)
 "$here/grid.sh" --status --out "$out" > "$to/status.txt"
 tar -C "$out" "${excludes[@]}" -cf - . | tar -C "$to" -xf -
-# A finished run's checkpoint would only serve grid.sh --extend: not worth its megabytes here.
-find "$to" -mindepth 3 -maxdepth 3 -name done -execdir rm -f checkpoint.bin actor_state.bin \;
+# A finished run's checkpoint only serves grid.sh --extend: kept when asked (--all-checkpoints).
+[ "$checkpoints" = 2 ] || find "$to" -mindepth 3 -maxdepth 3 -name done -execdir rm -f checkpoint.bin actor_state.bin \;
 # The environments (simulator states, doubles) halve under xz; restore_grid.sh unpacks them.
-if [ "$checkpoints" = 1 ]; then
+if [ "$checkpoints" -ge 1 ]; then
   find "$to" -mindepth 3 -maxdepth 3 -name actor_state.bin -exec xz -6 -T1 {} + || \
     { echo "record_grid.sh: compressing the environments (xz) failed" >&2; exit 1; }
 fi
@@ -86,8 +88,8 @@ dirty=$(git -C "$repo" status --porcelain --untracked-files=no -- . "${exclude[@
   echo "grid: $(grep -v '^#' "$out/grid.txt" | tr '\n' ' ')"
   grep '^#' "$out/grid.txt" || true
   echo "status: $(tail -n 1 "$to/status.txt")"
-  if [ "$checkpoints" = 1 ]; then
-    echo "checkpoints: $(find "$to" -name checkpoint.bin | wc -l) unfinished runs keep theirs" \
+  if [ "$checkpoints" -ge 1 ]; then
+    echo "checkpoints: $(find "$to" -name checkpoint.bin | wc -l) $([ "$checkpoints" = 2 ] || echo "unfinished ")runs keep theirs" \
          "(experiments/restore_grid.sh --from $to --out DIR brings the grid back to go on)"
   fi
   # Where each run went on, from its log. masa_train says it ("resumed at update K"), and whether

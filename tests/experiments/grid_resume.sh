@@ -273,4 +273,25 @@ head -c 1000 rec_stopped/a1_beam/masa_s0/actor_state.bin.xz > rec_damaged/a1_bea
 "$src/experiments/restore_grid.sh" --from rec_damaged --out restored5 > restore5.out 2>&1 && fail "a damaged record was restored"
 grep -q "unpacking a run's environments (actor_state.bin.xz) failed; nothing restored" restore5.out && [ ! -e restored5 ] || \
   fail "damaged record: $(cat restore5.out)"
-echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, recorded, filmed, hosts file used, restored from its record"
+# 5b. A finished grid recorded without its finished runs' checkpoints cannot be extended where it is
+# restored (its runs would start afresh): refused by name, nothing changed. With --all-checkpoints
+# the restored grid goes on to more updates from where each run finished, environments and all.
+"$src/experiments/restore_grid.sh" --from rec --out restored_fin > restore6.out 2>&1 || fail "restore failed: $(cat restore6.out)"
+"$src/experiments/grid.sh" --extend 170 --out restored_fin > grid8.out 2>&1 && fail "a grid without its runs' checkpoints was extended"
+grep -q "needs each finished run's checkpoint, and these have none: a1_beam/masa_s0 a1_beam/sa_s0" grid8.out || \
+  fail "no reason given: $(cat grid8.out)"
+grep -q "^updates=160$" restored_fin/grid.txt && [ -f restored_fin/a1_beam/masa_s0/done ] || fail "the refused extension changed the grid"
+"$src/experiments/record_grid.sh" --out grid --to rec_all --all-checkpoints > rec7.out 2>&1 || fail "--all-checkpoints failed: $(cat rec7.out)"
+for m in masa sa; do
+  [ -s "rec_all/a1_beam/${m}_s0/checkpoint.bin" ] && [ -s "rec_all/a1_beam/${m}_s0/actor_state.bin.xz" ] || \
+    fail "--all-checkpoints did not keep finished $m's checkpoint and environments"
+done
+grep -q "^checkpoints: 2 runs keep theirs" rec_all/RECORD.txt || fail "RECORD.txt: $(grep checkpoints rec_all/RECORD.txt)"
+"$src/experiments/restore_grid.sh" --from rec_all --out restored_all > restore7.out 2>&1 || fail "restore failed: $(cat restore7.out)"
+"$src/experiments/grid.sh" --extend 170 --out restored_all > grid9.out 2>&1 || fail "extending the restored grid failed: $(cat grid9.out)"
+for m in masa sa; do
+  grep -q "^masa_train: resumed at update 160 (.*); the environments go on as they were" "restored_all/a1_beam/${m}_s0.log" && \
+    [ -f "restored_all/a1_beam/${m}_s0/done" ] && [ "$(wc -l < "restored_all/a1_beam/${m}_s0/metrics.csv")" -eq 171 ] || \
+    fail "the restored $m run did not go on from 160 to 170: $(grep resumed "restored_all/a1_beam/${m}_s0.log")"
+done
+echo "PASS: killed at update $rows_at_kill, resumed to 150, finished runs not redone, comparison drawn, extended to 160, recorded, filmed, hosts file used, restored from its record, extended after a restore"
