@@ -13,20 +13,22 @@
 # labels' order), then masa_compare's compare.png, verdict.md and runs.csv. --updates defaults to
 # the fewest any run has; a run with fewer than --updates is kept as unfinished and named.
 # --reference (default: the first label) is compared against every other label. Labels: letters,
-# digits, '.', '-'. Refuses an existing DIR (--force replaces it). MASA_BUILD_DIR chooses the build.
+# digits, '.', '-'. --milestone [TASK:]COLUMN=LEVEL (repeatable) adds when each run first reaches
+# LEVEL (as grid.sh's). Refuses an existing DIR (--force replaces it). MASA_BUILD_DIR chooses the build.
 set -euo pipefail
 caller=$(pwd)
 cd "$(dirname "$0")/.."
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
-usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
+usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
 die() { echo "compare_runs.sh: $*" >&2; exit 2; }
-out="" updates="" reference="" force=0 pairs=()
+out="" updates="" reference="" force=0 pairs=() milestones=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out=$(abs "${2:?--out needs a directory}"); shift 2 ;;
     --updates) updates=${2:?--updates needs a number}; shift 2 ;;
     --reference) reference=${2:?--reference needs a label}; shift 2 ;;
     --force) force=1; shift ;;
+    --milestone) milestones+=(--milestone "${2:?--milestone needs [TASK:]COLUMN=LEVEL}"); shift 2 ;;
     -h|--help) usage ;;
     -*) die "unknown option '$1' (see --help)" ;;
     *=*) pairs+=("$1"); shift ;;
@@ -86,5 +88,5 @@ for i in "${!labels[@]}"; do
 done
 [ ${#short[@]} -eq 0 ] || echo "compare_runs.sh: fewer than $updates updates, kept as unfinished: ${short[*]}" >&2
 build=${MASA_BUILD_DIR:-build}
-"$build/tools/masa_compare" "$out" --reference "$reference"
+"$build/tools/masa_compare" "$out" --reference "$reference" "${milestones[@]+"${milestones[@]}"}"
 echo "compare_runs.sh: ${#labels[@]} runs of ${#order[@]} labels at $updates updates -> $out (verdict.md, <task>/compare.png; sources.txt)"

@@ -8,6 +8,7 @@
 #   experiments/grid.sh --extend N --out DIR    (the grid's runs go on to N updates each)
 #   experiments/grid.sh --out DIR --seeds "0 ... 9"  (more seeds, methods or tasks: the grid grows)
 #   experiments/grid.sh --status --out DIR      (each run's progress and the grid's ETA)
+#   experiments/grid.sh --replot --out DIR --milestone eval_distance_m=5  (when each run first walks 5 m)
 # Resumable: run the same command again (or with --out DIR) after a kill. A finished run (its
 # `done` file) is not redone, a run with a checkpoint goes on from it, the rest start afresh.
 # Runs are taken seed by seed, so a grid stopped early has whole seeds of every method.
@@ -18,6 +19,9 @@
 # --hosts FILE: one line per host, "name [slots]" ("localhost" runs here). Remote hosts need this
 # checkout, built, at the same path; the run directory is copied there before and back after each
 # run (MASA_SSH and MASA_RSYNC choose the commands, default ssh and rsync).
+# --milestone [TASK:]COLUMN=LEVEL (repeatable): the verdict adds when each run's COLUMN (a metrics.csv
+# column, e.g. an evaluation figure) first reaches LEVEL; kept in grid.txt, it can be added to a
+# grid at any time (a rerun or --replot) without changing its runs.
 # MASA_BUILD_DIR chooses the build (default build).
 set -euo pipefail
 caller=$(pwd)
@@ -28,6 +32,7 @@ repo=$(pwd)
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
 
 tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1 extend="" grown=()
+milestones=()
 status=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -40,14 +45,20 @@ while [ $# -gt 0 ]; do
     --hosts) hosts=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --set) sets+=("$2"); shift 2 ;;
+    --milestone) milestones+=("$2"); shift 2 ;;
     --no-recipe) recipe=0; shift ;;
     --replot) replot=1; shift ;;
     --extend) extend=$2; shift 2 ;;
     --status) status=1; shift ;;
-    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+for x in "${milestones[@]+"${milestones[@]}"}"; do
+  [[ "$x" =~ ^([A-Za-z0-9_]+:)?[A-Za-z0-9_]+=[-+]?[0-9.]+([eE][-+]?[0-9]+)?$ ]] || \
+    { echo "grid.sh: --milestone '$x': write [TASK:]COLUMN=LEVEL, e.g. eval_distance_m=5" >&2; exit 2; }
+done
+[ ${#milestones[@]} -eq 0 ] || [ "$status" = 0 ] || { echo "grid.sh: --status only reads; give --milestone with --replot" >&2; exit 2; }
 [ -n "$out" ] && out=$(abs "$out")
 [ -n "$hosts" ] && hosts=$(abs "$hosts")
 build=${MASA_BUILD_DIR:-build}
@@ -58,7 +69,7 @@ build=${MASA_BUILD_DIR:-build}
 if [ -n "$extend" ]; then
   [ -n "$out" ] && [ -f "$out/grid.txt" ] || { echo "grid.sh: --extend needs --out with an existing grid (its grid.txt)" >&2; exit 2; }
   [[ "$extend" =~ ^[1-9][0-9]*$ ]] || { echo "grid.sh: --extend takes a number of updates, not '$extend'" >&2; exit 2; }
-  if [ -n "$tasks$methods$seeds$updates" ] || [ ${#sets[@]} -gt 0 ] || [ "$replot" = 1 ]; then
+  if [ -n "$tasks$methods$seeds$updates" ] || [ ${#sets[@]} -gt 0 ] || [ ${#milestones[@]} -gt 0 ] || [ "$replot" = 1 ]; then
     echo "grid.sh: --extend changes only the updates of the grid in --out: give it no other grid options" >&2; exit 2
   fi
   have=$(sed -n 's/^updates=//p' "$out/grid.txt")
@@ -89,12 +100,14 @@ if [ -n "$out" ] && [ -f "$out/grid.txt" ]; then
   g_seeds=$(sed -n 's/^seeds=//p' <<< "$saved"); g_updates=$(sed -n 's/^updates=//p' <<< "$saved")
   g_recipe=$(sed -n 's/^recipe=//p' <<< "$saved"); g_sets=$(sed -n 's/^set=//p' <<< "$saved")
   # Naming all the grid has and more (seeds, methods, tasks) grows it: its runs stay, the new ones
-  # join the queue. Anything else that differs is another grid.
+  # join the queue. The same ones in another order are the grid as it is. Anything else that
+  # differs is another grid.
+  words() { tr -s ' ' '\n' <<< "$1" | sed '/^$/d' | sort -u; }
   for k in tasks methods seeds updates; do
     want=${!k}; have=$(eval echo "\$g_$k")
     { [ -z "$want" ] || [ "$want" = "$have" ]; } && continue
-    words() { tr -s ' ' '\n' <<< "$1" | sed '/^$/d' | sort -u; }
     if [ "$k" != updates ] && [ -z "$(comm -23 <(words "$have") <(words "$want"))" ]; then
+      if [ -z "$(comm -13 <(words "$have") <(words "$want"))" ]; then printf -v "$k" '%s' "$have"; continue; fi
       grown+=("$k '$have' -> '$want'"); continue
     fi
     echo "grid.sh: $out is the grid $k='$have', not '$want' (use another --out; to grow it, name all it has and more)" >&2
@@ -116,8 +129,10 @@ else
   mkdir -p "$out"
   { echo "tasks=$tasks"; echo "methods=$methods"; echo "seeds=$seeds"; echo "updates=$updates"
     echo "recipe=$recipe"; for x in "${sets[@]+"${sets[@]}"}"; do echo "set=$x"; done
+    for x in "${milestones[@]+"${milestones[@]}"}"; do echo "milestone=$x"; done
     echo "# started $(date -u +%FT%TZ) at commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
   } > "$out/grid.txt"
+  milestones=()
 fi
 out=$(cd "$out" && pwd)
 
@@ -197,12 +212,25 @@ if [ -z "$extend" ]; then
     exit 3
   fi
 fi
+# A milestone whose column the grid's runs so far do not have is refused before anything changes.
+for x in "${milestones[@]+"${milestones[@]}"}"; do
+  t=${x%%=*}; column=${t#*:}; t=${t%"$column"}; t=${t%:}
+  headers=$(for f in "$out"/${t:-*}/*_s*/metrics.csv; do [ ! -f "$f" ] || head -n 1 "$f"; done)
+  [ -z "$headers" ] || tr ',' '\n' <<< "$headers" | grep -qxF "$column" || \
+    { echo "grid.sh: --milestone $x: the runs of $out${t:+ ($t)} have no column '$column'" >&2; exit 2; }
+done
 # A grid that grows writes its new definition only under the lock: a running grid's never changes.
 if [ ${#grown[@]} -gt 0 ]; then
   for k in tasks methods seeds; do sed -i "s/^$k=.*/$k=${!k}/" "$out/grid.txt"; done
   echo "# grew: ${grown[*]} $(date -u +%FT%TZ) at commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)" >> "$out/grid.txt"
   echo "grid.sh: $out grows: ${grown[*]}"
 fi
+# New milestones join the grid's (masa_compare reads them from grid.txt); its runs do not change.
+for x in "${milestones[@]+"${milestones[@]}"}"; do
+  grep -qxF "milestone=$x" "$out/grid.txt" && continue
+  echo "milestone=$x" >> "$out/grid.txt"
+  echo "grid.sh: $out compares milestone $x"
+done
 
 if [ "$replot" = 0 ]; then
   # The queue: one line per run, seeds outermost. Workers take lines under a lock.

@@ -4,6 +4,7 @@
 // verdict of the reference method (MASA) against each baseline with bootstrap intervals over seeds.
 //   masa_compare experiments/results/a1_beam_grid            (DIR/<task>/<method>_s<seed>/metrics.csv)
 //   masa_compare DIR --reference masa --resamples 10000 --no-plot
+//   masa_compare DIR --milestone eval_distance_m=5     (when each run's evaluation first walks 5 m)
 // Writes DIR/<task>/curves/<metric>_<method>.dat (env_steps wall_s median q25 q75 n), curves.csv
 // (the same, one table), runs.csv (one row per run), compare.gp and compare.png; DIR/verdict.md,
 // DIR/compare_all.gp and DIR/compare_all.png (every task on one page). `gnuplot compare.gp` in
@@ -168,7 +169,20 @@ std::string fmt(double v, int precision = 1) {
   return buf;
 }
 
+// A level as written: 5, 0.25, 1e+06.
+std::string shortest(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 std::string millions(double steps) { return std::isnan(steps) ? "n/a" : fmt(steps / 1e6, 2) + "M"; }
+
+// Env steps in millions from 100k up, else whole; "-" for none (not reached).
+std::string steps(double v) {
+  if (std::isnan(v)) return "-";
+  return std::fabs(v) >= 1e5 ? millions(v) : fmt(v, 0);
+}
 
 std::string color(const std::string& method, size_t index) {
   static const std::map<std::string, std::string> fixed = {
@@ -202,6 +216,56 @@ std::string panel(const std::string& prefix, const std::string& metric, const st
   return plot + "\n";
 }
 
+// A milestone, [TASK:]COLUMN=LEVEL: the env steps of the first row at which a run's COLUMN reaches
+// LEVEL (an evaluation figure: when the policy mean first walks 5 m), in the tasks that have it.
+struct Milestone {
+  std::string task;  // empty: every task with the column
+  std::string column;
+  double level = 0;
+  std::string text;
+  bool from_grid = false;  // grid.txt's: one that fits no task is noted, not fatal (the runs stand)
+  std::string unmatched;   // why it fits no task, if it does not
+  bool matched = false;
+};
+
+Milestone parseMilestone(const std::string& text) {
+  static const std::regex form("(?:([A-Za-z0-9_]+):)?([A-Za-z0-9_]+)=([-+0-9.eE]+)");
+  std::smatch m;
+  Milestone out;
+  char* end = nullptr;
+  if (std::regex_match(text, m, form)) {
+    const std::string level = m[3];
+    out.level = std::strtod(level.c_str(), &end);
+    if (end == level.c_str() + level.size() && std::isfinite(out.level)) {
+      out.task = m[1];
+      out.column = m[2];
+      out.text = text;
+      return out;
+    }
+  }
+  throw std::runtime_error("milestone '" + text + "': write [TASK:]COLUMN=LEVEL, e.g. eval_distance_m=5");
+}
+
+// The command line's milestones, then the grid's (grid.txt lines "milestone=...") not among them.
+std::vector<Milestone> readMilestones(const fs::path& dir, const std::vector<std::string>& given) {
+  std::vector<Milestone> out;
+  for (const auto& t : given) out.push_back(parseMilestone(t));
+  std::ifstream grid(dir / "grid.txt");
+  std::string line;
+  while (std::getline(grid, line)) {
+    if (line.rfind("milestone=", 0) != 0) continue;
+    const std::string text = line.substr(10);
+    if (std::find(given.begin(), given.end(), text) != given.end()) continue;
+    try {
+      out.push_back(parseMilestone(text));
+    } catch (const std::exception& e) {
+      throw std::runtime_error((dir / "grid.txt").string() + ": " + e.what());
+    }
+    out.back().from_grid = true;
+  }
+  return out;
+}
+
 struct TaskResult {
   std::string task;
   std::vector<std::string> methods;
@@ -216,15 +280,20 @@ int main(int argc, char** argv) {
   std::string dir_arg, reference = "masa";
   int resamples = 10000;
   bool no_plot = false;
+  std::vector<std::string> milestone_texts;
   app.add_option("dir", dir_arg, "the grid's directory (DIR/<task>/<method>_s<seed>/metrics.csv)")->required();
   app.add_option("--reference", reference, "the method compared against every other");
   app.add_option("--resamples", resamples, "bootstrap resamples")->check(CLI::Range(100, 1000000));
   app.add_flag("--no-plot", no_plot, "write the tables and gnuplot scripts, do not run gnuplot");
+  app.add_option("--milestone", milestone_texts,
+                 "[TASK:]COLUMN=LEVEL: when each run's COLUMN first reaches LEVEL (repeatable; grid.txt "
+                 "lines milestone=... add theirs)");
   CLI11_PARSE(app, argc, argv);
 
   try {
     const fs::path dir = fs::absolute(dir_arg);
     if (!fs::is_directory(dir)) throw std::runtime_error(dir_arg + ": no such directory");
+    std::vector<Milestone> milestones = readMilestones(dir, milestone_texts);
     const std::regex run_name("(.+)_s([0-9]+)");
     std::vector<std::string> task_names;
     for (const auto& e : fs::directory_iterator(dir))
@@ -406,6 +475,56 @@ int main(int argc, char** argv) {
         verdict << "\n";
       }
 
+      for (auto& ms : milestones) {
+        if (!ms.task.empty() && ms.task != task) continue;
+        if (!any.columns.count(ms.column)) {
+          if (!ms.task.empty()) ms.unmatched = task + "'s metrics.csv has no column '" + ms.column + "'";
+          continue;
+        }
+        ms.matched = true;
+        verdict << "Milestone " << ms.column << " >= " << shortest(ms.level)
+                << ": the env steps of the first row at which it holds (an evaluation figure is known only "
+                << "at the evaluations); a seed that never reaches it within the budget counts as later than "
+                << "any that does.\n\n| method | seeds that reach it | per seed | median | " << reference
+                << " - method: steps [95%] |\n|---|---|---|---|---|\n";
+        std::map<std::string, std::vector<double>> reached;  // NaN: not within the budget
+        for (const auto& m : methods)
+          for (const Run* r : used[m])
+            reached[m].push_back(stats::firstReached(r->col("env_steps"), r->col(ms.column), ms.level, budget));
+        auto allReached = [](const std::vector<double>& v) {
+          return std::none_of(v.begin(), v.end(), [](double x) { return std::isnan(x); });
+        };
+        for (const auto& m : methods) {
+          const auto& v = reached[m];
+          std::vector<double> sorted;  // a run that never reached it is beyond any that did
+          std::string per_seed;
+          int count = 0;
+          for (size_t i = 0; i < v.size(); ++i) {
+            count += !std::isnan(v[i]);
+            sorted.push_back(std::isnan(v[i]) ? std::numeric_limits<double>::infinity() : v[i]);
+            per_seed += (i ? ", s" : "s") + std::to_string(used[m][i]->seed) + " " + steps(v[i]);
+          }
+          // The median by hand: interpolating towards "never" (infinity) would give NaN.
+          std::sort(sorted.begin(), sorted.end());
+          const size_t n = sorted.size();
+          const double med = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+          std::string diff;
+          if (m != reference && reached.count(reference)) {
+            const auto& a = reached[reference];
+            if (allReached(a) && allReached(v) && !a.empty() && !v.empty()) {
+              Rng rng(12345);
+              const auto iv = stats::bootstrapMeanDifference(a, v, resamples, 0.95, rng);
+              diff = steps(iv.estimate) + " [" + steps(iv.low) + ", " + steps(iv.high) + "]";
+            } else {
+              diff = "n/a (a seed never reached it)";
+            }
+          }
+          verdict << "| " << m << " | " << count << " of " << v.size() << " | " << per_seed << " | "
+                  << (std::isinf(med) ? "not within the budget" : steps(med)) << " | " << diff << " |\n";
+        }
+        verdict << "\n";
+      }
+
       // The task's figure: training return, evaluation figures against steps; return against time.
       const size_t panels = metrics.size() + 1;
       const int cols = panels > 2 ? 2 : static_cast<int>(panels);
@@ -432,6 +551,16 @@ int main(int argc, char** argv) {
                   methods.size(), most_seeds, millions(budget).c_str(), (dir / task / "compare.png").c_str());
     }
     if (drawn.empty()) throw std::runtime_error(dir_arg + ": no runs (<task>/<method>_s<seed>/metrics.csv) found");
+    for (auto& ms : milestones) {
+      if (ms.matched) continue;
+      if (ms.unmatched.empty())
+        ms.unmatched = ms.task.empty() ? "no task's metrics.csv has the column '" + ms.column + "'"
+                                       : "the grid has no task '" + ms.task + "' with runs";
+      if (!ms.from_grid) throw std::runtime_error("milestone " + ms.text + ": " + ms.unmatched);
+      std::fprintf(stderr, "masa_compare: warning: grid.txt's milestone %s: %s\n", ms.text.c_str(),
+                   ms.unmatched.c_str());
+      verdict << "Milestone " << ms.text << " (grid.txt): not measured, " << ms.unmatched << ".\n\n";
+    }
 
     {
       std::ofstream v(dir / "verdict.md");

@@ -64,6 +64,13 @@ double firstCrossing(const std::vector<double>& x, const std::vector<double>& y,
   return kNaN;
 }
 
+double firstReached(const std::vector<double>& x, const std::vector<double>& y, double level, double x_max) {
+  if (x.size() != y.size()) throw std::invalid_argument("firstReached: x and y differ in length");
+  for (size_t i = 0; i < x.size() && x[i] <= x_max; ++i)
+    if (!std::isnan(y[i]) && y[i] >= level) return x[i];
+  return kNaN;
+}
+
 std::vector<double> trailingMean(const std::vector<double>& y, int window) {
   if (window < 1) throw std::invalid_argument("trailingMean: window must be at least 1");
   std::vector<double> out(y.size(), kNaN);

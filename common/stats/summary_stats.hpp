@@ -25,6 +25,11 @@ double meanUnderCurve(const std::vector<double>& x, const std::vector<double>& y
 // reached at its own x.
 double firstCrossing(const std::vector<double>& x, const std::vector<double>& y, double level);
 
+// The x of the first point with y >= level, not interpolated: for a figure measured only now and
+// then (an evaluation every N updates), where nothing is known between two measurements. NaN
+// values are skipped; NaN when y never reaches the level at x <= x_max.
+double firstReached(const std::vector<double>& x, const std::vector<double>& y, double level, double x_max);
+
 // Trailing mean over `window` points (fewer at the start); NaN values are left out of the mean.
 std::vector<double> trailingMean(const std::vector<double>& y, int window);
 

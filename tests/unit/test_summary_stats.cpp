@@ -43,6 +43,18 @@ TEST(SummaryStats, FirstCrossingInterpolatesToTheLevel) {
   EXPECT_TRUE(std::isnan(firstCrossing({0, 10}, {0, 1}, 2.0)));
 }
 
+TEST(SummaryStats, FirstReachedIsTheFirstMeasurementAtTheLevel) {
+  // Evaluations at 0, 10, 20, 30 (NaN: no evaluation at that update): no interpolation.
+  EXPECT_DOUBLE_EQ(firstReached({0, 5, 10, 20, 30}, {1, NAN, 4, 6, 9}, 5.0, 1e9), 20.0);
+  EXPECT_DOUBLE_EQ(firstReached({0, 10, 20}, {1, 5, 9}, 5.0, 1e9), 10.0);  // reaching is enough
+  EXPECT_DOUBLE_EQ(firstReached({0, 10, 20, 30}, {0, 6, 1, 9}, 5.0, 1e9), 10.0);  // the first time
+  EXPECT_DOUBLE_EQ(firstReached({5, 10}, {7, 1}, 5.0, 1e9), 5.0);
+  // Beyond x_max does not count: the budget every run of a comparison shares.
+  EXPECT_TRUE(std::isnan(firstReached({0, 10, 20}, {1, 2, 9}, 5.0, 15.0)));
+  EXPECT_TRUE(std::isnan(firstReached({0, 10}, {NAN, 4}, 5.0, 1e9)));
+  EXPECT_THROW(firstReached({0, 1}, {0}, 1.0, 1e9), std::invalid_argument);
+}
+
 TEST(SummaryStats, TrailingMeanAveragesThePastWindow) {
   const auto m = trailingMean({1, 2, 3, 4, NAN, 6}, 3);
   ASSERT_EQ(m.size(), 6u);
