@@ -507,7 +507,9 @@ int main(int argc, char** argv) {
           // The median by hand: interpolating towards "never" (infinity) would give NaN.
           std::sort(sorted.begin(), sorted.end());
           const size_t n = sorted.size();
-          const double med = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+          const double med = n == 0       ? std::numeric_limits<double>::infinity()
+                             : n % 2 ? sorted[n / 2]
+                                     : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
           std::string diff;
           if (m != reference && reached.count(reference)) {
             const auto& a = reached[reference];
