@@ -192,6 +192,7 @@ bool PolicyRunner::poll(int64_t now_us, masa::lcmt_robot_command& cmd) {
     started_ = true;
     next_due_us_ = state_rx_us_;
     last_cmd_us_ = now_us - period_us_;
+    wall_minus_now_us_ = wallMicros() - now_us;
     for (int k = 0; k < n_; ++k) prev_target_[k] = target_[k] = hold_pose_[k] = std::clamp(q_[k], lower_[k], upper_[k]);
     reason_ = "ramp to the nominal pose";
   }
@@ -320,7 +321,9 @@ void PolicyRunner::finishCommand(int64_t now_us, masa::lcmt_robot_command& cmd) 
     cmd.kp[k] = std::clamp(kp_[k], 0.0, cfg_.max_kp);
     cmd.kd[k] = std::clamp(kd_[k], 0.0, cfg_.max_kd);
   }
-  cmd.utime = wallMicros();
+  // Not the wall clock read now: poll() took the time before the policy ran (up to milliseconds
+  // on a loaded machine), and the limits above are per interval of now_us.
+  cmd.utime = now_us + wall_minus_now_us_;
   cmd.state_utime = answered_utime_;
   cmd.runner_id = runner_id_;
   cmd.sequence = sequence_++;

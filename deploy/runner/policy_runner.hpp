@@ -66,7 +66,9 @@ class PolicyRunner {
   // wrong joint count is ignored (counted), one whose utime does not advance is not fresh.
   void onState(const masa::lcmt_robot_state& s, int64_t rx_us);
   // Fills `cmd` (utime, sequence and runner_id too) and returns true when a command is to be
-  // published now. `cmd` must have been made by makeCommand().
+  // published now. `cmd` must have been made by makeCommand(). The command's utime is now_us on
+  // the wall clock (the offset fixed at the first command): the instant its rate limits were
+  // computed for, so the target rates the robot sees between utimes are the limits.
   bool poll(int64_t now_us, masa::lcmt_robot_command& cmd);
   // The latest time poll() must be called again (for the LCM wait); INT64_MAX: only on a state.
   int64_t nextDeadline(int64_t now_us) const;
@@ -120,6 +122,7 @@ class PolicyRunner {
   Mode mode_ = Mode::kCalibrating;
   std::string reason_;
   int64_t next_due_us_ = 0, last_cmd_us_ = 0, sequence_ = 0, answered_rx_us_ = 0, answered_utime_ = 0;
+  int64_t wall_minus_now_us_ = 0;  // cmd.utime - now_us, fixed at the first command
   int settled_ = 0;
   bool to_policy_ = false;
   double interval_us_ = 0;  // mean time between states (exponential average)

@@ -266,7 +266,7 @@ TEST(DeployRunner, EmergencyCrouchReachesTheCrouchPoseWithinItsRate) {
   int64_t last_t = 1500000 - static_cast<int64_t>(r.periodS() * 1e6);
   double farthest = 0;  // rad between the measured pose and the crouch pose
   for (int k = 0; k < r.numJoints(); ++k) farthest = std::max(farthest, std::abs(c.crouch_pose[k] - measured[k]));
-  int64_t reached_at = -1;
+  int64_t reached_at = -1, last_utime = 0;
   for (int64_t t = 1500000, n = 0; t < 6000000; t += 500) {
     if (t > 1500000 && t < 2000000 && t % 5000 == 0) r.onState(stateOf(*f.sim, ++utime), t);  // then the state stops
     if (t > 1500000 && !r.poll(t, cmd)) continue;
@@ -276,6 +276,12 @@ TEST(DeployRunner, EmergencyCrouchReachesTheCrouchPoseWithinItsRate) {
     for (int k = 0; k < r.numJoints(); ++k) {
       ASSERT_LE(std::abs(cmd.position[k] - prev[k]), c.crouch_max_rate * (t - last_t) * 1e-6 + 1e-12)
           << "joint " << k << " moved too fast at " << t;
+      // As the robot sees it: between the commands' utimes (failed before: the wall clock read
+      // after the step was computed, microseconds apart here).
+      if (last_utime > 0) {
+        ASSERT_LE(std::abs(cmd.position[k] - prev[k]), c.crouch_max_rate * (cmd.utime - last_utime) * 1e-6 + 1e-12)
+            << "joint " << k << " moved too fast between utimes at " << t;
+      }
       ASSERT_EQ(cmd.kp[k], c.crouch_kp);
       ASSERT_EQ(cmd.kd[k], c.crouch_kd);
       at_pose = at_pose && cmd.position[k] == c.crouch_pose[k];
@@ -283,6 +289,7 @@ TEST(DeployRunner, EmergencyCrouchReachesTheCrouchPoseWithinItsRate) {
     if (at_pose && reached_at < 0) reached_at = t;
     prev.assign(cmd.position.begin(), cmd.position.end());
     last_t = t;
+    last_utime = cmd.utime;
   }
   ASSERT_GT(reached_at, 0) << "the crouch pose was never reached";
   // No faster than the rate allows, and not much slower: one period of slack.
@@ -334,7 +341,7 @@ TEST(DeployRunner, LimitsHoldOnEveryCommandForRandomPolicies) {
     PolicyRunner r(f.lp, c, 1);
     std::normal_distribution<double> noise(0.0, 1.0);
     masa::lcmt_robot_command cmd = r.makeCommand();
-    int64_t last_t = -1, policy_commands = 0;
+    int64_t last_t = -1, last_utime = 0, policy_commands = 0;
     std::vector<double> prev;
     for (int64_t t = 0, utime = 0; t < 1000000; t += 500) {
       if (t % 5000 == 0) {
@@ -359,11 +366,14 @@ TEST(DeployRunner, LimitsHoldOnEveryCommandForRandomPolicies) {
         if (cmd.mode == static_cast<int>(Mode::kPolicy) && !prev.empty()) {
           ASSERT_LE(std::abs(cmd.position[k] - prev[k]), c.max_target_rate * (t - last_t) * 1e-6 + 1e-12)
               << "joint " << k << " moved too fast at " << t;
+          ASSERT_LE(std::abs(cmd.position[k] - prev[k]), c.max_target_rate * (cmd.utime - last_utime) * 1e-6 + 1e-12)
+              << "joint " << k << " moved too fast between the commands' utimes at " << t;
         }
       }
       policy_commands += cmd.mode == static_cast<int>(Mode::kPolicy);
       prev.assign(cmd.position.begin(), cmd.position.end());
       last_t = t;
+      last_utime = cmd.utime;
     }
     EXPECT_GT(policy_commands, 20) << "seed " << seed;
   }
