@@ -83,7 +83,7 @@ dirty=$(git -C "$repo" status --porcelain --untracked-files=no -- . "${exclude[@
 {
   echo "recorded: $(date -u +%Y-%m-%dT%H:%M:%SZ) from $out"
   echo "checkout: $commit${dirty:+ (with uncommitted changes)}"
-  echo "machine: $(hostname), $(nproc --all) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
+  echo "machine: $("$here/machine.sh")"
   echo "build: ${MASA_BUILD_DIR:-build} (each run's log starts with the exact command it ran)"
   echo "grid: $(grep -v '^#' "$out/grid.txt" | tr '\n' ' ')"
   grep '^#' "$out/grid.txt" || true

@@ -51,7 +51,7 @@ for t in $tasks; do for m in $methods; do for s in $seeds; do
 done; done; done
 
 commit=$(git -C "$(dirname "$0")" rev-parse --short HEAD 2> /dev/null || echo unknown)
-echo "# restored $(date -u +%FT%TZ) from $from at commit $commit on $(hostname): $finished finished," \
+echo "# restored $(date -u +%FT%TZ) from $from at commit $commit on $("$(dirname "$0")/machine.sh"): $finished finished," \
      "$going_on go on from their checkpoints, $afresh begun but without a checkpoint start afresh" >> "$out/grid.txt"
 echo "restore_grid.sh: $out: $finished runs finished, $going_on go on from their checkpoints," \
      "$afresh start afresh; go on with: experiments/grid.sh --out $out"
