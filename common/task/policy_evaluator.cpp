@@ -64,7 +64,10 @@ EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook, con
   for (int t = 0; t < limit && !active.empty(); ++t) {
     const int m = static_cast<int>(active.size());
     for (int j = 0; j < m; ++j) envs[active[j]]->observe(obs.col(j).data());
-    act.leftCols(m) = model_->actMean(obs.leftCols(m));
+    // One column at a time: Eigen multiplies a single column (GEMV) and a batch (GEMM) with
+    // different summation orders, which on AVX2 round differently, and an episode must not
+    // depend on how many others run beside it.
+    for (int j = 0; j < m; ++j) act.col(j) = model_->actMean(obs.col(j));
     if (!o.deterministic)
       for (int j = 0; j < m; ++j) {  // each episode's own generator: independent of the batch's make-up
         Mat<float> mean = act.col(j);
