@@ -173,8 +173,8 @@ cmp -s rec/a1_beam/masa_s0/metrics.csv grid/a1_beam/masa_s0/metrics.csv || fail 
 grep -Eq "^checkout: [0-9a-f]{40}" rec/RECORD.txt && grep -q "^grid: tasks=a1_beam methods=masa sa" rec/RECORD.txt || \
   fail "RECORD.txt: $(cat rec/RECORD.txt)"
 # The machine with its vector ISA: -march=native builds on AVX2 and on AVX-512 round differently.
-cpu_line="^machine: .*, [0-9]+ cores, .*\((x86 family [0-9]+ model [0-9]+; )?(avx2|avx|no avx)(, (no )?avx512)?\)\$"
-grep -Eq "$cpu_line" rec/RECORD.txt || fail "RECORD.txt does not name the CPU's ISA: $(grep machine rec/RECORD.txt)"
+cpu_isa="\((x86 family [0-9]+ model [0-9]+; )?(avx2|avx|no avx)(, (no )?avx512)?\)"
+grep -Eq "^machine: .*, [0-9]+ cores, .*$cpu_isa\$" rec/RECORD.txt || fail "RECORD.txt does not name the CPU's ISA: $(grep machine rec/RECORD.txt)"
 grep -q "^2 done, 0 running" rec/status.txt || fail "the recorded status: $(cat rec/status.txt)"
 # Where each run was resumed: masa at the kill and at the extension, sa at the extension only.
 # masa_train says so in the log; logs of binaries from before that give the same from where each
@@ -276,7 +276,7 @@ grep -q "^rsync -a far-host:$PWD/remote/a1_beam/masa_s0/ $PWD/remote/a1_beam/mas
 # record, the begun run starts afresh. Refused over an existing directory and for a non-grid.
 "$src/experiments/restore_grid.sh" --from rec_stopped --out restored > restore.out 2>&1 || fail "restore_grid.sh failed: $(cat restore.out)"
 grep -q "0 runs finished, 1 go on from their checkpoints, 0 start afresh" restore.out || fail "restore said: $(cat restore.out)"
-grep -Eq "^# restored .* from rec_stopped at commit .* on .*\((x86 family [0-9]+ model [0-9]+; )?(avx2|avx|no avx)(, (no )?avx512)?\): 0 finished, 1 go on" \
+grep -Eq "^# restored .* from rec_stopped at commit .* on .*$cpu_isa: 0 finished, 1 go on" \
   restored/grid.txt || fail "grid.txt does not say where (which CPU) it was restored: $(cat restored/grid.txt)"
 [ ! -e restored/RECORD.txt ] && [ ! -e restored/status.txt ] || fail "the record's own files came along"
 cmp -s <(xz -dc rec_stopped/a1_beam/masa_s0/actor_state.bin.xz) restored/a1_beam/masa_s0/actor_state.bin && \
