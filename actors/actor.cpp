@@ -106,6 +106,8 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
         std::make_unique<transport::Transport>(options_.url.empty() ? transport::loopbackUrl() : options_.url, options_.run_key);
     transport_ = owned_transport_.get();
   }
+  if (!options_.rollout_url.empty() && options_.rollout_url != transport_->url())
+    rollout_transport_ = std::make_unique<transport::Transport>(options_.rollout_url, options_.run_key);
   char host[256] = {};
   if (gethostname(host, sizeof host - 1) == 0) hostname_ = host;
   transport_->subscribe<masa::lcmt_policy_params>(
@@ -217,7 +219,7 @@ void Actor::publishHeartbeat() {
   hb.steps_per_second = (dt > 0.0 && dt < 1e9) ? static_cast<float>(steps_since_heartbeat_ / dt) : 0.0f;
   hb.policy_version = version_;
   hb.rollouts_sent = rollouts_sent_;
-  transport_->publish(transport::kHeartbeatChannel, hb);
+  sender().publish(transport::kHeartbeatChannel, hb);
   last_heartbeat_s_ = now;
   steps_since_heartbeat_ = 0;
 }
@@ -315,7 +317,7 @@ bool Actor::collectAndPublish() {
       ++chunks_dropped_;  // fault injection: as if the network had lost it
       continue;
     }
-    transport_->publish(transport::kRolloutChannel, chunk);
+    sender().publish(transport::kRolloutChannel, chunk);
     ++chunks_published_;
   }
   ++rollouts_sent_;

@@ -38,6 +38,9 @@ struct ActorOptions {
   int num_envs = 1;
   int64_t run_id = 0;
   std::string url;               // "" -> transport::loopbackUrl(); ignored with an external transport
+  // Where rollouts and heartbeats go, when not to `url`: its learner rank's own URL in a
+  // data-parallel run (docs/scaling.md), while the parameters still come on `url`. "" = url.
+  std::string rollout_url;
   // Authenticates every message (common/transport/message_auth.hpp): the learner's run key. None:
   // unsigned (--no-auth). Ignored with an external transport.
   std::optional<transport::RunKey> run_key;
@@ -144,6 +147,8 @@ class Actor {
   int horizon_;
   std::unique_ptr<transport::Transport> owned_transport_;
   transport::Transport* transport_;
+  std::unique_ptr<transport::Transport> rollout_transport_;  // options.rollout_url's, when it differs
+  transport::Transport& sender() { return rollout_transport_ ? *rollout_transport_ : *transport_; }
   std::unique_ptr<task::TaskFactory> factory_;
   std::vector<std::unique_ptr<task::Task>> envs_;
   std::vector<Rng> rngs_;

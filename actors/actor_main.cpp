@@ -3,10 +3,14 @@
 //   masa_actor --set task=a1_beam --actor-id 0 --num-envs 64 --run-id 42 --key-file RUN_DIR/run.key
 // Every message is authenticated with the learner's run key (--key-file); --no-auth turns that off.
 // Exit status 0 on a clean stop (SIGINT/SIGTERM or --max-rollouts), 2 on bad input.
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -14,6 +18,8 @@
 #include "actors/actor.hpp"
 #include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
+#include "common/cluster/job_plan.hpp"
+#include "common/cluster/mpi_job.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/run_key.hpp"
 
@@ -23,6 +29,15 @@ extern "C" void onSignal(int) { g_stop.store(true); }
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Started by mpirun or srun beside the learner ranks (docs/scaling.md): the job says who this
+  // actor is, which run, and where its rollouts go; no key file, run id or URL is needed.
+  std::unique_ptr<masa::cluster::MpiJob> job;
+  try {
+    if (masa::cluster::launchedByMpi()) job = std::make_unique<masa::cluster::MpiJob>(masa::cluster::Role::kActor);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "masa_actor: %s\n", e.what());
+    return 2;
+  }
   CLI::App app{"masa actor: simulate environments and stream rollouts to the learner"};
   app.set_version_flag("--version", masa::buildCommit());
   std::vector<std::string> overrides;
@@ -76,6 +91,30 @@ int main(int argc, char** argv) {
   app.add_option("--drop-seed", opt.drop_seed, "seed of the generator that picks the chunks to throw away")
       ->capture_default_str()->group("Fault injection");
   CLI11_PARSE(app, argc, argv);
+  if (job) {
+    try {
+      std::vector<uint8_t> bytes;
+      job->shareFromLearnerZero(bytes);
+      const auto plan = masa::cluster::JobPlan::decode(bytes);
+      opt.actor_id = job->roleIndex();
+      opt.run_id = plan.run_id;
+      opt.url = plan.url;
+      // Actor i reports to learner rank i mod (number of ranks).
+      opt.rollout_url = job->learnerCount() > 1
+                            ? masa::transport::rankRolloutUrl(plan.url, opt.actor_id % job->learnerCount())
+                            : plan.url;
+      if (plan.key) {
+        masa::transport::RunKey k;
+        k.bytes = *plan.key;
+        opt.run_key = k;
+      }
+      no_auth = !plan.key;
+      key_file = plan.key ? "(from learner rank 0)" : "";
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "masa_actor: %s\n", e.what());
+      job->abort(2);
+    }
+  }
   if (key_file.empty() && !no_auth) {
     std::fprintf(stderr, "masa_actor: no run key: give --key-file RUN_DIR/run.key (the learner's), or --no-auth to "
                          "run without message authentication\n");
@@ -87,7 +126,11 @@ int main(int argc, char** argv) {
   opt.stop = &g_stop;
   try {
     const auto rc = masa::config::loadRunConfig(configs, overrides, run_config);
-    if (no_auth) {
+    if (job) {
+      std::fprintf(stderr, "masa_actor %d: actor %d of %d in an MPI job, rollouts to learner rank %d on %s\n",
+                   opt.actor_id, opt.actor_id, job->actorCount(), opt.actor_id % job->learnerCount(),
+                   opt.rollout_url.c_str());
+    } else if (no_auth) {
       std::fprintf(stderr, "masa_actor %d: WARNING: --no-auth: messages are neither signed nor checked; anyone who "
                            "can reach this network can make this actor act with their parameters\n", opt.actor_id);
     } else {
@@ -96,6 +139,22 @@ int main(int argc, char** argv) {
                    key_file.c_str(), opt.run_key->id().c_str());
     }
     masa::actor::Actor actor(rc, opt);
+    // In an MPI job the actors end when the learner ranks say training is over.
+    std::thread watcher;
+    std::atomic<bool> acting{true};
+    if (job)
+      watcher = std::thread([&] {
+        while (acting.load() && !job->trainingFinished()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        g_stop.store(true);
+      });
+    struct Join {
+      std::thread& t;
+      std::atomic<bool>& acting;
+      ~Join() {
+        acting.store(false);
+        if (t.joinable()) t.join();
+      }
+    } join{watcher, acting};
     std::fprintf(stderr, "masa_actor %d: task %s, %d envs, horizon %d, run %lld; %s\n", opt.actor_id,
                  rc.task.c_str(), opt.num_envs, rc.ppo.horizon, static_cast<long long>(opt.run_id),
                  opt.start_without_learner ? "starting with own parameters" : "waiting for parameters");
@@ -113,6 +172,7 @@ int main(int argc, char** argv) {
                  opt.actor_id, static_cast<long long>(actor.paramsRejected()), actor.transport().rejectSummary().c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_actor: %s\n", e.what());
+    if (job) job->abort(2);
     return 2;
   }
   return 0;

@@ -59,6 +59,11 @@ bool isCheckpointFile(const std::string& path) {
 CheckpointState readCheckpoint(const std::string& path, model::ActorCritic<float>& model, nn::Adam<float>* adam) {
   std::ifstream is(path, std::ios::binary);
   if (!is) throw std::runtime_error(path + ": cannot open the checkpoint");
+  return readCheckpoint(is, path, model, adam);
+}
+
+CheckpointState readCheckpoint(std::istream& is, const std::string& path, model::ActorCritic<float>& model,
+                               nn::Adam<float>* adam) {
   char magic[sizeof kMagic];
   is.read(magic, sizeof magic);
   if (!is || std::memcmp(magic, kMagic, sizeof magic) != 0)

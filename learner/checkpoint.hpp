@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,10 @@ void writeCheckpoint(const std::string& path, const CheckpointState& state, cons
 // Reads the state and loads the model; loads the optimizer too unless `adam` is null (evaluation).
 // Throws std::runtime_error naming the file and what is wrong.
 CheckpointState readCheckpoint(const std::string& path, model::ActorCritic<float>& model, nn::Adam<float>* adam);
+// The same from a checkpoint's bytes in a stream (data-parallel ranks get rank 0's file this way);
+// `name` says where they came from in errors.
+CheckpointState readCheckpoint(std::istream& is, const std::string& name, model::ActorCritic<float>& model,
+                               nn::Adam<float>* adam);
 
 bool isCheckpointFile(const std::string& path);
 

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/cluster/rank_agreement.hpp"
 #include "common/core/check.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/task/policy_evaluator.hpp"
@@ -64,9 +65,14 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
       dir_(options.run_dir),
       rng_(rc.seed),
       round_(rc.runner.loss_grace_s),
-      min_batch_envs_(static_cast<int>(std::ceil(rc.runner.min_batch_fraction * rc.ppo.num_envs))) {
+      ranks_(options.ranks ? options.ranks : &cluster::soloCommunicator()),
+      rank_envs_(rc.ppo.num_envs / ranks_->size()) {
   MASA_CHECK(!dir_.empty(), "learner: no run directory");
-  fs::create_directories(dir_);
+  MASA_CHECK(rc.ppo.num_envs % ranks_->size() == 0, "ppo.num_envs " << rc.ppo.num_envs << " must divide among the "
+                                                                     << ranks_->size() << " learner ranks");
+  MASA_CHECK(opt_.rank_check_every > 0, "rank_check_every must be positive, got " << opt_.rank_check_every);
+  min_batch_envs_ = static_cast<int>(std::ceil(rc.runner.min_batch_fraction * rank_envs_));
+  if (isLeadRank()) fs::create_directories(dir_);
   const auto spec = sym::SymmetrySpec::load(rc_.spec_path);
   model_ = std::make_unique<model::ActorCritic<float>>(spec, modelConfigOf(rc_));
   model_->initialize(rng_);
@@ -77,28 +83,36 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   MASA_CHECK(batch_samples % rc_.ppo.minibatch_size == 0,
              "ppo.minibatch_size " << rc_.ppo.minibatch_size << " must divide the batch, ppo.num_envs x ppo.horizon = "
                                    << batch_samples);
-  trainer_ = std::make_unique<ppo::PpoTrainer>(*model_, *adam_, rc_.ppo);
-  buffer_ = std::make_unique<ppo::RolloutBuffer>(rc_.ppo.num_envs, rc_.ppo.horizon, model_->obsDim(), model_->actDim());
+  trainer_ = std::make_unique<ppo::PpoTrainer>(*model_, *adam_, rc_.ppo, *ranks_);
+  buffer_ = std::make_unique<ppo::RolloutBuffer>(rank_envs_, rc_.ppo.horizon, model_->obsDim(), model_->actDim());
 
   run_id_ = options.run_id;
   if (opt_.resume) loadCheckpoint();  // sets run_id_ unless one was given
   // Rewritten on resume too: overrides given then are part of the run from now on.
-  std::ofstream(fs::path(dir_) / "config.yaml") << config::dumpResolved(rc_);
+  if (isLeadRank()) std::ofstream(fs::path(dir_) / "config.yaml") << config::dumpResolved(rc_);
   if (run_id_ == 0) run_id_ = randomRunId();
+  if (ranks_->size() > 1) {
+    // Rank 0's run id for every rank (the actors carry one), and the same start everywhere.
+    run_id_ = ranks_->gather(run_id_)[0];
+    checkRanksAgree();
+  }
   assembler_ = std::make_unique<RolloutAssembler>(assemblerConfig(run_id_, rc_, model_->obsDim(), model_->actDim()));
   assembler_->setLearnerVersion(updates_);
 
-  transport_ = std::make_unique<transport::Transport>(opt_.url, opt_.run_key);
+  const std::string intake_url = opt_.rollout_url.empty() ? opt_.url : opt_.rollout_url;
+  transport_ = std::make_unique<transport::Transport>(intake_url, opt_.run_key);
+  if (isLeadRank() && intake_url != opt_.url)
+    policy_transport_ = std::make_unique<transport::Transport>(opt_.url, opt_.run_key);
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
 
-  if (rc_.runner.eval_every > 0) {
+  if (rc_.runner.eval_every > 0 && isLeadRank()) {
     eval_factory_ = std::make_unique<task::TaskFactory>(rc_.task, spec, rc_.env, rc_.origin);
     columns_.progress_names = eval_factory_->create()->progressNames();
   }
 
   start_ = last_update_ = std::chrono::steady_clock::now();
   silence_ = std::make_unique<SilenceWatch>(rc_.runner.silence_warn_s, start_);
-  publishParams();
+  if (isLeadRank()) publishParams();
 }
 
 void Learner::evaluate() {
@@ -145,7 +159,7 @@ void Learner::onChunk(const void* data, int size) {
   round_.chunkArrived(m.actor_id, m.rollout_seq, m.chunk_index, m.num_chunks, now);
   if (!collector_) {
     CollectorConfig c;
-    c.num_envs = rc_.ppo.num_envs;
+    c.num_envs = rank_envs_;
     c.horizon = rc_.ppo.horizon;
     c.obs_dim = model_->obsDim();
     c.act_dim = model_->actDim();
@@ -167,26 +181,51 @@ int Learner::waitMs(int timeout_ms) const {
 }
 
 bool Learner::step(int timeout_ms) {
-  transport_->handleTimeout(waitMs(timeout_ms));
+  transport_->handleTimeout(waiting_for_ranks_ ? std::min(timeout_ms, 1) : waitMs(timeout_ms));
   transport_->drain();
   bool updated = false;
-  if (collector_ && collector_->take(*buffer_)) {
-    update();
-    updated = true;
-  } else if (collector_ && round_.settled(std::chrono::steady_clock::now()) &&
-             collector_->takeShort(*buffer_, min_batch_envs_)) {
-    update();  // the missing environments were lost: waiting would not bring them
-    updated = true;
+  if (!waiting_for_ranks_) {
+    bool batch = collector_ && collector_->take(*buffer_);
+    // The missing environments were lost: waiting would not bring them.
+    if (!batch && collector_ && round_.settled(std::chrono::steady_clock::now()))
+      batch = collector_->takeShort(*buffer_, min_batch_envs_);
+    const bool stopping = stop_ && stop_->load();
+    if (ranks_->size() > 1 && (batch || stopping)) {
+      // The update is collective: wait for every rank's batch (or stop), receiving chunks meanwhile.
+      ranks_->beginBarrier();
+      waiting_for_ranks_ = true;
+    } else if (batch) {
+      update();
+      updated = true;
+    }
+  }
+  if (waiting_for_ranks_ && ranks_->barrierDone()) {
+    waiting_for_ranks_ = false;
+    // Every rank is here with a batch or a stop: all stop together if any stops (a signal reaches
+    // every rank of a job, but not at the same update), else all update.
+    double stopping = stop_ && stop_->load() ? 1.0 : 0.0;
+    ranks_->sum(&stopping, 1);
+    if (stopping > 0) {
+      ranks_stopped_ = true;
+    } else {
+      update();
+      updated = true;
+    }
   }
   const auto now = std::chrono::steady_clock::now();
-  if (std::chrono::duration<double>(now - last_publish_).count() >= rc_.runner.republish_every_s) publishParams();
+  if (isLeadRank() && std::chrono::duration<double>(now - last_publish_).count() >= rc_.runner.republish_every_s)
+    publishParams();
   if (auto warning = silence_->check(now, updates_, droppedChunks())) std::cerr << *warning << "\n";
   return updated;
 }
 
 void Learner::run(int64_t max_updates, const std::atomic<bool>* stop) {
   max_updates_ = max_updates;
-  while (updates_ < max_updates && !(stop && stop->load())) step(100);
+  stop_ = stop;
+  if (ranks_->size() == 1)
+    while (updates_ < max_updates && !(stop && stop->load())) step(100);
+  else  // ranks stop together (step())
+    while (updates_ < max_updates && !ranks_stopped_) step(100);
   writeCheckpoint();
   renderLearningCurve();
 }
@@ -205,7 +244,11 @@ void Learner::update() {
   const auto now = std::chrono::steady_clock::now();
   const double dt = std::chrono::duration<double>(now - last_update_).count();
   last_update_ = now;
-  const int64_t steps = static_cast<int64_t>(buffer_->size());
+  int64_t steps = static_cast<int64_t>(buffer_->size());
+  if (ranks_->size() > 1) {
+    steps = 0;
+    for (int64_t rank_steps : ranks_->gather(buffer_->size())) steps += rank_steps;
+  }
   env_steps_ += steps;
   report_.epoch = updates_;
   ++updates_;
@@ -215,9 +258,11 @@ void Learner::update() {
   report_.fps = dt > 0 ? steps / dt : 0.0;
   // The first interval includes start-up; later ones weigh in with a short memory.
   update_interval_s_ = updates_ <= 2 ? dt : 0.8 * update_interval_s_ + 0.2 * dt;
-  summarizeEpisodes(buffer_->data(), report_);
-  report_.dropped_chunks = droppedChunks();
-  report_.dropped_envs = droppedEnvs();
+  summarizeEpisodes(buffer_->data(), report_, *ranks_);
+  double drops[2] = {static_cast<double>(droppedChunks()), static_cast<double>(droppedEnvs())};
+  if (ranks_->size() > 1) ranks_->sum(drops, 2);  // every rank's, in metrics.csv and the progress line
+  report_.dropped_chunks = static_cast<int64_t>(drops[0]);
+  report_.dropped_envs = static_cast<int64_t>(drops[1]);
   report_.eval_return = report_.eval_length = report_.eval_success = std::nan("");
   report_.eval_progress.assign(columns_.progress_names.size(), std::nan(""));
   if (eval_factory_ && updates_ % rc_.runner.eval_every == 0) evaluate();
@@ -225,15 +270,30 @@ void Learner::update() {
   assembler_->setLearnerVersion(updates_);
   collector_->setLearnerVersion(updates_);
   round_.newRound();
+  if (ranks_->size() > 1 && updates_ % opt_.rank_check_every == 0) checkRanksAgree();
+  if (!isLeadRank()) return;  // rank 0 speaks for the ranks and keeps the run directory
   publishParams();
   report();
   if (rc_.runner.checkpoint_every > 0 && updates_ % rc_.runner.checkpoint_every == 0) writeCheckpoint();
   if (rc_.runner.snapshot_every > 0 && updates_ % rc_.runner.snapshot_every == 0) writeSnapshot();
 }
 
+void Learner::checkRanksAgree() {
+  const auto& p = model_->params().values();
+  uint64_t h = cluster::hashBytes(p.data(), sizeof(float) * static_cast<std::size_t>(p.size()));
+  for (const auto* norm : {&model_->obsNormalizer(), &model_->valueNormalizer()}) {
+    h = cluster::hashBytes(norm->mean().data(), sizeof(double) * static_cast<std::size_t>(norm->dim()), h);
+    h = cluster::hashBytes(norm->var().data(), sizeof(double) * static_cast<std::size_t>(norm->dim()), h);
+  }
+  const double lr = trainer_->learningRate().lr();
+  h = cluster::hashBytes(&lr, sizeof lr, h);
+  cluster::requireSameOnEveryRank(*ranks_, h, "parameters, normalizers or learning rate after update " +
+                                                 std::to_string(updates_));
+}
+
 void Learner::report() {
   const CollectorStats& c = collector_->stats();
-  transport_->publish(transport::kLearnerStatsChannel,
+  publisher().publish(transport::kLearnerStatsChannel,
                       statsMessage(report_, columns_, run_id_, dropStats(), c.envs_stale, c.envs_overflow));
   appendMetricsRow((fs::path(dir_) / "metrics.csv").string(), report_, columns_);
   if (!curve_)
@@ -275,11 +335,12 @@ void Learner::publishParams() {
   } else {
     m.obs_dim = 0;
   }
-  transport_->publish(transport::kPolicyChannel, m);
+  publisher().publish(transport::kPolicyChannel, m);
   last_publish_ = std::chrono::steady_clock::now();
 }
 
 void Learner::writeCheckpoint() {
+  if (!isLeadRank()) return;
   CheckpointState s;
   s.run_id = run_id_;
   s.updates = updates_;
@@ -298,7 +359,22 @@ void Learner::writeCheckpoint() {
 }
 
 void Learner::loadCheckpoint() {
-  const CheckpointState s = readCheckpoint((fs::path(dir_) / "checkpoint.bin").string(), *model_, adam_.get());
+  const std::string path = (fs::path(dir_) / "checkpoint.bin").string();
+  CheckpointState s;
+  if (ranks_->size() == 1) {
+    s = readCheckpoint(path, *model_, adam_.get());
+  } else {
+    // Rank 0's file for every rank: the ranks need not share a file system.
+    std::vector<uint8_t> bytes;
+    if (isLeadRank()) {
+      std::ifstream in(path, std::ios::binary);
+      if (!in) throw std::runtime_error(path + ": cannot open the checkpoint");
+      bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    ranks_->broadcast(bytes, 0);
+    std::istringstream in(std::string(bytes.begin(), bytes.end()), std::ios::binary);
+    s = readCheckpoint(in, path + " (rank 0's)", *model_, adam_.get());
+  }
   if (run_id_ == 0) run_id_ = s.run_id;  // keep the run: its actors go on being accepted
   if (s.version != s.updates)
     throw std::runtime_error("resume: " + dir_ + "/checkpoint.bin has policy version " + std::to_string(s.version) +
@@ -310,7 +386,7 @@ void Learner::loadCheckpoint() {
   rng_text >> rng_;
   if (!rng_text) throw std::runtime_error("resume: corrupt rng state in " + dir_ + "/checkpoint.bin");
   restored_order_ = s.order;
-  truncateMetricsCsv((fs::path(dir_) / "metrics.csv").string(), s.updates);  // rows past the checkpoint come again
+  if (isLeadRank()) truncateMetricsCsv((fs::path(dir_) / "metrics.csv").string(), s.updates);  // rows past the checkpoint come again
   trainer_->learningRate().setLr(s.lr);
   adam_->config().lr = static_cast<float>(s.lr);
 }

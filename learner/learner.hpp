@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "common/cluster/communicator.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/actor_critic.hpp"
 #include "common/nn/adam.hpp"
@@ -46,6 +47,14 @@ struct LearnerOptions {
   // or in-process memq runs).
   std::optional<transport::RunKey> run_key;
   bool verbose = true;  // one progress line per update on stdout
+  // Data-parallel (docs/scaling.md): this process is learner rank ranks->rank() of ranks->size(),
+  // taking ppo.num_envs / size environments of every batch from the actors that send to its
+  // rollout_url. Rank 0 alone publishes parameters and stats (on url) and writes the run
+  // directory; every rank checks every rank_check_every updates that all hold the same parameters.
+  // Null: the only learner.
+  cluster::Communicator* ranks = nullptr;
+  std::string rollout_url;  // "" = url
+  int rank_check_every = 10;
 };
 
 class Learner {
@@ -74,7 +83,10 @@ class Learner {
   // Renders <run dir>/learning_curve.png now (false without gnuplot or before the first update).
   bool renderLearningCurve();
 
+  // The intake's transport (rollouts); rank 0's parameters and stats go out on publisher().
   transport::Transport& transport() { return *transport_; }
+  transport::Transport& publisher() { return policy_transport_ ? *policy_transport_ : *transport_; }
+  bool isLeadRank() const { return ranks_->rank() == 0; }
   int64_t runId() const { return run_id_; }
   // Updates done (resumed ones included). The policy version is the same count: the number of
   // updates the broadcast parameters have seen (update_report.hpp says how updates are counted).
@@ -98,6 +110,8 @@ class Learner {
   // How long step() may wait for traffic: at most timeout_ms, less when a short batch comes due sooner.
   int waitMs(int timeout_ms) const;
   void update();
+  // Every rank's parameters, normalizers and learning rate hash the same, or RankDisagreement.
+  void checkRanksAgree();
   // Tells the update: the stats message, metrics.csv, the curve, the progress line.
   void report();
   void loadCheckpoint();
@@ -115,7 +129,13 @@ class Learner {
   std::unique_ptr<ppo::PpoTrainer> trainer_;
   std::unique_ptr<ppo::RolloutBuffer> buffer_;
 
+  cluster::Communicator* ranks_;
+  int rank_envs_;  // this rank's environments of a full batch
+  bool waiting_for_ranks_ = false;  // a batch is taken (or a stop asked); the ranks' barrier is pending
+  bool ranks_stopped_ = false;      // the ranks agreed to stop
+  const std::atomic<bool>* stop_ = nullptr;  // run()'s
   std::unique_ptr<transport::Transport> transport_;
+  std::unique_ptr<transport::Transport> policy_transport_;  // rank 0, when the rollouts come on another URL
   std::unique_ptr<RolloutAssembler> assembler_;  // made once the run id is known
   std::unique_ptr<SilenceWatch> silence_;
   // Made on the first accepted chunk: the reward term names come from the actors' task.

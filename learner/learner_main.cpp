@@ -5,7 +5,9 @@
 // Every message is authenticated with the run key (--key-file, default RUN_DIR/run.key, made when
 // missing); --no-auth turns that off.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
+#include <memory>
 #include <csignal>
 #include <ctime>
 #include <exception>
@@ -17,6 +19,8 @@
 #include "common/build_info/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
+#include "common/cluster/job_plan.hpp"
+#include "common/cluster/mpi_job.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/run_key.hpp"
 #include "learner/intake/drop_reason.hpp"
@@ -41,6 +45,15 @@ std::string timestamp() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Started by mpirun or srun: one of the job's learner ranks (docs/scaling.md). MPI first, so that
+  // a rank that fails below still ends the whole job instead of leaving it waiting.
+  std::unique_ptr<masa::cluster::MpiJob> job;
+  try {
+    if (masa::cluster::launchedByMpi()) job = std::make_unique<masa::cluster::MpiJob>(masa::cluster::Role::kLearner);
+  } catch (const std::exception& e) {
+    std::cerr << "masa_learner: " << e.what() << "\n";
+    return 2;
+  }
   CLI::App app{"masa learner: multi-agent PPO fed by actors over LCM"};
   app.set_version_flag("--version", masa::buildCommit());
   std::vector<std::string> overrides;
@@ -64,7 +77,14 @@ int main(int argc, char** argv) {
                                  "when missing; give the actors the same file)");
   app.add_flag("--no-auth", no_auth, "send and accept messages without authentication (anyone on the network can "
                                      "then feed this run rollouts)")->excludes(key_opt);
+  int rank_check_every = 10;
+  app.add_option("--rank-check-every", rank_check_every,
+                 "data-parallel ranks compare parameter hashes every this many updates")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
+  masa::cluster::Communicator* ranks = job ? &job->learners() : nullptr;
+  const bool lead = !ranks || ranks->rank() == 0;
+  const std::string who = ranks ? "masa_learner " + ranks->describe() : "masa_learner";
 
   try {
     // A resumed run reads its own config.yaml: the run goes on with the settings it started with.
@@ -73,6 +93,10 @@ int main(int argc, char** argv) {
     masa::learner::LearnerOptions opt;
     opt.url = url;
     opt.run_id = run_id;
+    opt.ranks = ranks;
+    opt.rank_check_every = rank_check_every;
+    opt.verbose = lead;
+    if (ranks) opt.rollout_url = masa::transport::rankRolloutUrl(url, ranks->rank());
     if (!resume_dir.empty()) {
       opt.resume = true;
       opt.run_dir = resume_dir;
@@ -82,39 +106,69 @@ int main(int argc, char** argv) {
                                            std::to_string(rc.seed) + "_" + timestamp();
     }
     if (max_updates < 0) max_updates = rc.ppo.max_epochs;
+    if (ranks) {
+      // Rank 0's run directory (its default has rank 0's timestamp) for every rank.
+      std::vector<uint8_t> dir(opt.run_dir.begin(), opt.run_dir.end());
+      ranks->broadcast(dir, 0);
+      opt.run_dir.assign(dir.begin(), dir.end());
+    }
     if (no_auth) {
       std::cerr << "masa_learner: WARNING: --no-auth: messages are neither signed nor checked; anyone who can "
                    "reach this network can feed this run rollouts\n";
-    } else {
+    } else if (lead) {
       std::filesystem::create_directories(opt.run_dir);
       if (key_file.empty()) key_file = (std::filesystem::path(opt.run_dir) / "run.key").string();
       opt.run_key = masa::transport::readOrCreateRunKey(key_file);
       std::cout << "masa_learner: messages authenticated with the run key " << key_file << " (key id "
                 << opt.run_key->id() << ")" << std::endl;
     }
+    if (ranks && !no_auth) {
+      // Rank 0's key for the other ranks, over MPI: never on a command line or in a shared file.
+      std::vector<uint8_t> key;
+      if (lead) key.assign(opt.run_key->bytes.begin(), opt.run_key->bytes.end());
+      ranks->broadcast(key, 0);
+      masa::transport::RunKey k;
+      if (key.size() != k.bytes.size()) throw std::runtime_error("run key from rank 0 has " + std::to_string(key.size()) + " bytes");
+      std::copy(key.begin(), key.end(), k.bytes.begin());
+      opt.run_key = k;
+    }
 
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     masa::learner::Learner learner(rc, opt);
-    std::cout << "masa_learner: run id " << learner.runId() << ", run dir " << learner.runDir() << ", version "
-              << learner.version() << ", url '" << url << "'" << std::endl;
+    std::cout << who << ": run id " << learner.runId() << ", run dir " << learner.runDir() << ", version "
+              << learner.version() << ", url '" << url << "'"
+              << (ranks ? ", rollouts on '" + opt.rollout_url + "'" : std::string()) << std::endl;
+    if (job) {
+      // The run for every actor of the job: its id, the parameters' URL, the key.
+      masa::cluster::JobPlan plan;
+      plan.run_id = learner.runId();
+      plan.url = url;
+      if (opt.run_key) plan.key = opt.run_key->bytes;
+      std::vector<uint8_t> bytes = lead ? plan.encode() : std::vector<uint8_t>{};
+      job->shareFromLearnerZero(bytes);
+    }
     // run() finishes the step in progress when a signal arrives, then checkpoints.
     learner.run(max_updates, &g_stop);
-    std::cout << "masa_learner: stopped after " << learner.updates() << " updates; checkpoint written" << std::endl;
+    if (job) job->finishTraining();  // the job's actors stop
+    std::cout << who << ": stopped after " << learner.updates() << " updates"
+              << (lead ? "; checkpoint written" : "") << std::endl;
     // What became of the actors' rollout chunks, by reason (lost: never arrived).
     const auto& drops = learner.dropStats();
-    std::cout << "masa_learner: rollout chunks accepted " << drops[masa::learner::DropReason::kAccepted];
+    std::cout << who << ": rollout chunks accepted " << drops[masa::learner::DropReason::kAccepted];
     for (int r = 1; r < masa::learner::kNumDropReasons; ++r) {
       const auto reason = static_cast<masa::learner::DropReason>(r);
       if (drops[reason] > 0) std::cout << ", " << masa::learner::dropReasonName(reason) << " " << drops[reason];
     }
     std::cout << std::endl;
-    std::cout << "masa_learner: updates on batches short of lost environments " << learner.shortBatches() << std::endl;
-    std::cout << "masa_learner: MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
-    std::cout << "masa_learner: other messages rejected before decoding: " << learner.transport().rejectSummary()
+    std::cout << who << ": updates on batches short of lost environments " << learner.shortBatches() << std::endl;
+    std::cout << who << ": MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
+    std::cout << who << ": other messages rejected before decoding: " << learner.transport().rejectSummary()
               << std::endl;
   } catch (const std::exception& e) {
-    std::cerr << "masa_learner: " << e.what() << "\n";
+    std::cerr << who << ": " << e.what() << "\n";
+    // A rank that stops alone would leave the others waiting in a collective: end the job.
+    if (job) job->abort(2);
     return 2;
   }
   return 0;

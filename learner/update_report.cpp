@@ -8,21 +8,26 @@
 
 namespace masa::learner {
 
-void summarizeEpisodes(const rollout::Rollout& d, UpdateReport& report) {
-  const int n = d.numEpisodes(), K = d.numTerms();
-  report.num_episodes = n;
-  report.mean_return = report.mean_length = 0;
-  report.term_means.assign(K, 0.0);
-  int measured = 0, succeeded = 0;
-  for (int i = 0; i < n; ++i) {
-    report.mean_return += d.episode_return[i];
-    report.mean_length += d.episode_length[i];
+void summarizeEpisodes(const rollout::Rollout& d, UpdateReport& report, cluster::Communicator& ranks) {
+  const int n_local = d.numEpisodes(), K = d.numTerms();
+  // [episodes, return sum, length sum, with a success measure, succeeded, term sums...]
+  std::vector<double> sums(5 + static_cast<std::size_t>(K), 0.0);
+  sums[0] = n_local;
+  for (int i = 0; i < n_local; ++i) {
+    sums[1] += d.episode_return[i];
+    sums[2] += d.episode_length[i];
     if (d.episode_success[i] >= 0) {
-      ++measured;
-      succeeded += d.episode_success[i] == 1;
+      sums[3] += 1;
+      sums[4] += d.episode_success[i] == 1;
     }
-    for (int k = 0; k < K; ++k) report.term_means[k] += d.episode_term_sums[static_cast<std::size_t>(i) * K + k];
+    for (int k = 0; k < K; ++k) sums[5 + k] += d.episode_term_sums[static_cast<std::size_t>(i) * K + k];
   }
+  if (ranks.size() > 1) ranks.sum(sums.data(), static_cast<int>(sums.size()));
+  const int n = static_cast<int>(sums[0]);
+  report.num_episodes = n;
+  report.mean_return = sums[1];
+  report.mean_length = sums[2];
+  report.term_means.assign(sums.begin() + 5, sums.end());
   if (n > 0) {
     report.mean_return /= n;
     report.mean_length /= n;
@@ -32,7 +37,7 @@ void summarizeEpisodes(const rollout::Rollout& d, UpdateReport& report) {
     report.mean_return = report.mean_length = std::nan("");
     for (double& t : report.term_means) t = std::nan("");
   }
-  report.success_rate = measured > 0 ? static_cast<double>(succeeded) / measured : -1.0;
+  report.success_rate = sums[3] > 0 ? sums[4] / sums[3] : -1.0;
 }
 
 masa::lcmt_learner_stats statsMessage(const UpdateReport& report, const ReportColumns& columns, int64_t run_id,

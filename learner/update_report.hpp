@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/cluster/communicator.hpp"
 #include "common/rollout/rollout.hpp"
 #include "learner/intake/drop_reason.hpp"
 #include "learner/ppo/ppo_trainer.hpp"
@@ -37,7 +38,9 @@ struct UpdateReport {
 
 // Episode statistics of a batch: mean return, length and reward terms, and the success rate over
 // the episodes that have a success measure (-1 when none has). NaN means when no episode ended.
-void summarizeEpisodes(const rollout::Rollout& batch, UpdateReport& report);
+// Data-parallel: over every rank's batch (the sums are summed across ranks before dividing).
+void summarizeEpisodes(const rollout::Rollout& batch, UpdateReport& report,
+                       cluster::Communicator& ranks = cluster::soloCommunicator());
 
 // Names of the reward terms and of the task's progress figures, for the columns.
 struct ReportColumns {

@@ -23,6 +23,9 @@ packages=(
   xz-utils
   # actors on other machines (deploy/train.sh --hosts)
   openssh-client
+  # clusters: data-parallel learner ranks and actors as one MPI job (mpirun; srun --mpi=pmix),
+  # and Slurm with munge for the test that runs that job on a one-host cluster
+  openmpi-bin libopenmpi-dev slurm-wlm munge
   # offscreen rendering of rollouts
   libglfw3-dev xvfb xauth ffmpeg libpng-dev
   # the run directory's learning_curve.png

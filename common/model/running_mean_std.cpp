@@ -36,8 +36,16 @@ template <typename S>
 void RunningMeanStd<S>::update(const ConstMatRef<S>& batch) {
   MASA_CHECK(batch.rows() == dim_, "batch has " << batch.rows() << " rows, normalizer dim " << dim_);
   if (batch.cols() == 0) return;
+  mergeMoments(batchMoments(batch));
+}
+
+template <typename S>
+Eigen::VectorXd RunningMeanStd<S>::batchMoments(const ConstMatRef<S>& batch) {
+  MASA_CHECK(batch.rows() == dim_, "batch has " << batch.rows() << " rows, normalizer dim " << dim_);
   // One pass of sums in double over the batch, or over its whole orbit when symmetric.
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(dim_), sum_sq = Eigen::VectorXd::Zero(dim_);
+  Eigen::VectorXd moments = Eigen::VectorXd::Zero(2 * dim_ + 1);
+  auto sum = moments.segment(0, dim_);
+  auto sum_sq = moments.segment(dim_, dim_);
   auto accumulate = [&](const auto& x) {
     for (Eigen::Index b = 0; b < x.cols(); ++b)
       for (int d = 0; d < dim_; ++d) {
@@ -49,7 +57,7 @@ void RunningMeanStd<S>::update(const ConstMatRef<S>& batch) {
   double n = static_cast<double>(batch.cols());
   if (transforms_.empty()) {
     accumulate(batch);
-  } else {
+  } else if (batch.cols() > 0) {
     if (orbit_scratch_.cols() < batch.cols()) orbit_scratch_.resize(dim_, batch.cols());
     auto y = orbit_scratch_.leftCols(batch.cols());
     for (const auto& t : transforms_) {
@@ -58,8 +66,17 @@ void RunningMeanStd<S>::update(const ConstMatRef<S>& batch) {
     }
     n *= static_cast<double>(transforms_.size());
   }
-  const Eigen::VectorXd batch_mean = sum / n;
-  const Eigen::VectorXd batch_var = (sum_sq / n - batch_mean.cwiseAbs2()).cwiseMax(0.0);
+  moments(2 * dim_) = n;
+  return moments;
+}
+
+template <typename S>
+void RunningMeanStd<S>::mergeMoments(const Eigen::VectorXd& moments) {
+  MASA_CHECK(moments.size() == 2 * dim_ + 1, "moments have " << moments.size() << " entries, normalizer dim " << dim_);
+  const double n = moments(2 * dim_);
+  if (n <= 0) return;
+  const Eigen::VectorXd batch_mean = moments.segment(0, dim_) / n;
+  const Eigen::VectorXd batch_var = (moments.segment(dim_, dim_) / n - batch_mean.cwiseAbs2()).cwiseMax(0.0);
   const double total = count_ + n;
   const Eigen::VectorXd delta = batch_mean - mean_;
   mean_ += delta * (n / total);

@@ -23,7 +23,13 @@ class RunningMeanStd {
   void setSymmetry(const std::vector<sym::SparseMap>& transforms, const std::vector<int>& classes);
   bool symmetric() const { return !transforms_.empty(); }
 
-  void update(const ConstMatRef<S>& batch);  // dim x B
+  void update(const ConstMatRef<S>& batch);  // dim x B = mergeMoments(batchMoments(batch))
+  // The two halves of update(), for data-parallel learners that sum the moments of their shares of
+  // one batch across ranks before merging: [sum (dim), sum of squares (dim), count], in double,
+  // over the batch or its whole orbit when symmetric. Summable: the moments of a batch are the sum
+  // of its parts' moments.
+  Eigen::VectorXd batchMoments(const ConstMatRef<S>& batch);
+  void mergeMoments(const Eigen::VectorXd& moments);
   void normalize(const ConstMatRef<S>& in, MatRef<S> out) const;    // (x - mean) / sqrt(var + eps)
   void denormalize(const ConstMatRef<S>& in, MatRef<S> out) const;  // x * sqrt(var + eps) + mean
 

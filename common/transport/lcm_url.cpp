@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 namespace masa::transport {
 
@@ -62,6 +63,34 @@ RecvBufCheck checkRecvBuf(int64_t requested, const std::string& rmem_max_path) {
     c.message = os.str();
   }
   return c;
+}
+
+}  // namespace masa::transport
+
+namespace masa::transport {
+
+std::string rankRolloutUrl(const std::string& url, int rank) {
+  const std::string scheme = "udpm://";
+  if (url.rfind(scheme, 0) != 0)
+    throw std::invalid_argument("data-parallel learner ranks need a udpm:// URL for their own rollout channels, got '" +
+                                url + "'");
+  const std::size_t colon = url.find(':', scheme.size());
+  const std::size_t end = url.find('?', scheme.size());
+  if (colon == std::string::npos || (end != std::string::npos && colon > end))
+    throw std::invalid_argument("'" + url + "' names no port (udpm://GROUP:PORT)");
+  const std::string port_text = url.substr(colon + 1, end == std::string::npos ? std::string::npos : end - colon - 1);
+  int port = 0;
+  try {
+    std::size_t used = 0;
+    port = std::stoi(port_text, &used);
+    if (used != port_text.size()) throw std::invalid_argument("trailing characters");
+  } catch (const std::exception&) {
+    throw std::invalid_argument("'" + url + "' has no numeric port");
+  }
+  const int rank_port = port + 1 + rank;
+  if (rank < 0 || port <= 0 || rank_port > 65535)
+    throw std::invalid_argument("'" + url + "': no port " + std::to_string(rank_port) + " for rank " + std::to_string(rank));
+  return url.substr(0, colon + 1) + std::to_string(rank_port) + (end == std::string::npos ? "" : url.substr(end));
 }
 
 }  // namespace masa::transport

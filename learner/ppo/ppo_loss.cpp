@@ -87,12 +87,14 @@ PpoLossStats PpoLoss<S>::compute(const PpoLossBatch<S>& in) {
     const S loss = err * err;
     S c = loss, dc = S(2) * err;
     if (config_.clip_value) {
-      const S err_clipped = old_v + std::clamp(v - old_v, -e, e) - r;
+      const S moved = v - old_v;
+      const S err_clipped = old_v + std::clamp(moved, -e, e) - r;
       const S loss_clipped = err_clipped * err_clipped;
-      // Where the clipped term wins, v is outside the clip range and the loss is flat in v.
       if (loss_clipped > loss) {
         c = loss_clipped;
-        dc = S(0);
+        // Outside the clip range the clipped term is flat in v. Inside it, it is the unclipped term
+        // itself (ahead only by rounding), with the same gradient.
+        dc = moved > -e && moved < e ? S(2) * err_clipped : S(0);
       }
     }
     critic += static_cast<double>(c);

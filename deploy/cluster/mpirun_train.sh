@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Trains as one MPI job: L data-parallel learner ranks and A actor processes, started, placed and
+# stopped by mpirun (Open MPI), on this machine or on the hosts of an Open MPI hostfile. Every
+# process learns its role and place from the job (docs/scaling.md): actor i sends its rollouts to
+# learner rank i mod L on that rank's own multicast port; learner rank 0 broadcasts the parameters,
+# writes the run directory and hands the run key to every process over MPI (never on a command
+# line). Ctrl-C stops the job; its checkpoint is resumable with --resume.
+#   deploy/cluster/mpirun_train.sh [task] [method] [--ranks L] [--actors A] [--envs E] [--threads T]
+#       [--hostfile FILE] [--updates N] [--run-dir DIR | --resume DIR] [--set key=value ...]
+#       [-- extra mpirun options]
+# Defaults: 2 ranks, 2 actors of 32 environments, 1 thread each; ppo.num_envs = A x E, which the
+# ranks share equally. With --hostfile the URL is LAN multicast (ttl=1); see
+# deploy/cluster/hostfile.example. MASA_BUILD_DIR (default build) is the build on every host (the
+# same path everywhere); MASA_LCM_URL overrides the URL; MASA_MPIRUN the mpirun to use.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+task=a1_beam method=masa
+[ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; shift; }
+[ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; shift; }
+ranks=2 actors=2 envs=32 threads=1 hostfile="" updates="" run_dir="" resume=""
+sets=() mpi_extra=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --ranks) ranks=$2; shift 2 ;;
+    --actors) actors=$2; shift 2 ;;
+    --envs) envs=$2; shift 2 ;;
+    --threads) threads=$2; shift 2 ;;
+    --hostfile) hostfile=$2; shift 2 ;;
+    --updates) updates=$2; shift 2 ;;
+    --run-dir) run_dir=$2; shift 2 ;;
+    --resume) resume=$2; shift 2 ;;
+    --set) sets+=(--set "$2"); shift 2 ;;
+    --) shift; mpi_extra=("$@"); break ;;
+    *) echo "mpirun_train.sh: unknown option '$1'" >&2; exit 2 ;;
+  esac
+done
+for n in "$ranks" "$actors" "$envs" "$threads"; do
+  [[ $n =~ ^[1-9][0-9]*$ ]] || { echo "mpirun_train.sh: '$n' is not a positive count" >&2; exit 2; }
+done
+(( actors % ranks == 0 )) || { echo "mpirun_train.sh: $actors actors do not divide among $ranks ranks" >&2; exit 2; }
+build=${MASA_BUILD_DIR:-build}
+for bin in "$build/learner/masa_learner" "$build/actors/masa_actor"; do
+  [ -x "$bin" ] || { echo "mpirun_train.sh: $bin is missing: build first (scripts/build.sh)" >&2; exit 2; }
+done
+if [ -n "$hostfile" ]; then
+  [ -f "$hostfile" ] || { echo "mpirun_train.sh: no hostfile '$hostfile'" >&2; exit 2; }
+  url=${MASA_LCM_URL:-"udpm://239.255.76.67:7667?ttl=1&recv_buf_size=8388608"}
+  mpi_extra=(--hostfile "$hostfile" "${mpi_extra[@]}")
+else
+  url=${MASA_LCM_URL:-"udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608"}
+fi
+
+config=(--set "task=$task" --set "method=$method" --set "ppo.num_envs=$((actors * envs))" "${sets[@]}")
+learner_args=(--url "$url")
+[ -n "$updates" ] && learner_args+=(--max-updates "$updates")
+if [ -n "$resume" ]; then
+  learner_args+=(--resume "$resume")
+  config=("${sets[@]}")
+  actor_config=(--run-config "$resume/config.yaml" "${sets[@]}")
+else
+  [ -n "$run_dir" ] && learner_args+=(--run-dir "$run_dir")
+  actor_config=("${config[@]}")
+fi
+# Open MPI refuses root unless told; a 2-core workstation runs more processes than cores.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+set -x
+exec "${MASA_MPIRUN:-mpirun}" --oversubscribe --bind-to none -x OMP_NUM_THREADS="$threads" "${mpi_extra[@]}" \
+  -np "$ranks" "$build/learner/masa_learner" "${config[@]}" "${learner_args[@]}" \
+  : -np "$actors" "$build/actors/masa_actor" "${actor_config[@]}" --num-envs "$envs" --threads "$threads"

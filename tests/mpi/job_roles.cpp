@@ -1,0 +1,52 @@
+// One MPI job of learner ranks and actors (MPMD), as a cluster launch makes it:
+//   mpirun -np 2 masa_test_mpi_job_roles learner : -np 3 masa_test_mpi_job_roles actor
+// Every process learns the job's shape and its index among its role; learner rank 0's bytes reach
+// every process; actors see training going on until every learner rank has ended it, then see it
+// over. Exit status 0 everywhere and "PASS" from learner rank 0 when all of that holds.
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "common/cluster/mpi_job.hpp"
+
+int main(int argc, char** argv) {
+  using namespace masa::cluster;
+  if (argc != 2 || (std::strcmp(argv[1], "learner") != 0 && std::strcmp(argv[1], "actor") != 0)) {
+    std::fprintf(stderr, "usage: %s learner|actor\n", argv[0]);
+    return 2;
+  }
+  const bool learner = std::strcmp(argv[1], "learner") == 0;
+  int failures = 0;
+  auto expect = [&](bool ok, const std::string& what) {
+    if (!ok) {
+      ++failures;
+      std::fprintf(stderr, "FAILED (%s): %s\n", argv[1], what.c_str());
+    }
+  };
+  MpiJob job(learner ? Role::kLearner : Role::kActor);
+  expect(job.learnerCount() == 2 && job.actorCount() == 3, "2 learner ranks and 3 actors in a job of 5");
+  expect(job.roleIndex() == (learner ? job.worldRank() : job.worldRank() - 2), "the index among the role follows the world rank");
+  if (learner) expect(job.learners().size() == 2 && job.learners().rank() == job.roleIndex(), "the learners' communicator");
+
+  std::vector<uint8_t> plan;
+  if (learner && job.roleIndex() == 0) plan = {'r', 'u', 'n', 0, 255};
+  job.shareFromLearnerZero(plan);
+  expect(plan == std::vector<uint8_t>{'r', 'u', 'n', 0, 255}, "learner rank 0's bytes reach every process");
+
+  if (learner) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // "training"
+    job.finishTraining();
+  } else {
+    int polls_before = 0;
+    while (!job.trainingFinished()) {
+      ++polls_before;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    expect(polls_before >= 5, "actors see training go on while the learners train");
+  }
+  if (learner && job.roleIndex() == 0 && failures == 0) std::printf("PASS\n");
+  return failures == 0 ? 0 : 1;
+}

@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Training as one MPI job (issue #30): 2 learner ranks and 2 actors started by mpirun (MPMD), over
+# real LCM on loopback multicast, each actor feeding its own rank's URL.
+#  1. The job trains to --max-updates and every process exits 0: the actors stop when the learner
+#     ranks end training. metrics.csv has one row per update and counts the env steps of both
+#     ranks; the ranks checked their parameter hashes (every 2 updates) without a mismatch.
+#  2. Resumed as a new job from rank 0's checkpoint, it goes on to the new total.
+#  3. A learner rank killed with SIGKILL ends the whole job within seconds (no hang).
+#  4. Ctrl-C of mpirun (SIGINT) stops every process within seconds, the learners after a checkpoint.
+#   tests/mpi/train_ranks.sh [BUILD_DIR]
+set -euo pipefail
+source "$(dirname "$0")/../integration/lib.sh"
+[ $# -ge 1 ] && { build=$1; learner_bin="$build/learner/masa_learner"; actor_bin="$build/actors/masa_actor"; }
+require_binaries
+mpirun_sh="$masa_repo/tests/mpi/mpirun.sh"
+work=$(mktemp -d "${TMPDIR:-/tmp}/masa_mpi_ranks.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+port=$(( 7800 + RANDOM % 100 * 4 ))
+url="udpm://239.255.76.67:$port?ttl=0&recv_buf_size=8388608"
+# 16 envs x 16 steps, 8 a rank; the seed marks this test's processes (pgrep)
+marker=$((100000 + RANDOM * 7 % 800000))
+sets=("${test_sets[@]}" --set ppo.horizon=16 --set ppo.minibatch_size=128 --set seed=$marker)
+job_processes() { pgrep -fc "^($learner_bin|$actor_bin) .*seed=$marker" || true; }
+
+job() {  # job UPDATES [extra learner args]: 2 learner ranks, 2 actors of 8 environments
+  local updates=$1; shift
+  timeout 120 "$mpirun_sh" -np 2 "$learner_bin" "${sets[@]}" --url "$url" --max-updates "$updates" --rank-check-every 2 "$@" \
+    : -np 2 "$actor_bin" "${sets[@]}" --num-envs 8 --await-params-s 5
+}
+
+log "1. 2 learner ranks + 2 actors, 6 updates"
+job 6 --run-dir "$work/run" > "$work/job1.log" 2>&1 || fail "the job failed or hung (exit $?)"
+rows=$(($(wc -l < "$work/run/metrics.csv") - 1))
+[ "$rows" -eq 6 ] || fail "metrics.csv has $rows rows, expected 6"
+steps=$(tail -n 1 "$work/run/metrics.csv" | cut -d, -f3)
+[ "$steps" -eq $((6 * 16 * 16)) ] || fail "env steps $steps, expected $((6 * 16 * 16)) (both ranks' batches)"
+grep -q "rank 1 of 2: run id" "$work/job1.log" || fail "no rank 1"
+[ "$(grep -c 'rollouts to learner rank' "$work/job1.log")" -eq 2 ] || fail "the actors did not report their ranks"
+grep -q "differ between learner ranks" "$work/job1.log" && fail "the ranks disagreed"
+grep -q "stopped after" "$work/job1.log" || fail "no clean stop"
+[ -f "$work/run/checkpoint.bin" ] && [ -f "$work/run/policy.bin" ] || fail "rank 0 wrote no checkpoint or policy"
+log "   6 updates, $steps env steps, every process exited 0"
+
+log "2. resumed as a new job to 9 updates"
+job 9 --resume "$work/run" > "$work/job2.log" 2>&1 || fail "the resumed job failed or hung (exit $?)"
+rows=$(($(wc -l < "$work/run/metrics.csv") - 1))
+[ "$rows" -eq 9 ] || fail "after resuming metrics.csv has $rows rows, expected 9"
+log "   resumed from 6 to 9"
+
+log "3. a learner rank killed with SIGKILL ends the job"
+( job 1000 --run-dir "$work/run_kill" > "$work/job3.log" 2>&1 ) &
+launcher=$!
+for _ in $(seq 1 300); do
+  [ -f "$work/run_kill/metrics.csv" ] && [ "$(wc -l < "$work/run_kill/metrics.csv")" -ge 3 ] && break
+  sleep 0.1
+done
+victim=$(pgrep -f "^$learner_bin .*run_kill" | tail -n 1) || fail "no learner rank to kill"
+kill -KILL "$victim"
+t0=$(date +%s)
+for _ in $(seq 1 100); do kill -0 "$launcher" 2> /dev/null || break; sleep 0.1; done
+kill -0 "$launcher" 2> /dev/null && { pkill -KILL -f "run_kill" || true; fail "the job still runs 10 s after a rank was killed"; }
+sleep 0.5
+[ "$(job_processes)" -eq 0 ] || fail "$(job_processes) processes of the job are left"
+log "   the job ended $(( $(date +%s) - t0 )) s after the kill, nothing left"
+
+log "4. Ctrl-C of mpirun"
+job 1000 --run-dir "$work/run_int" > "$work/job4.log" 2>&1 &
+launcher=$!
+for _ in $(seq 1 300); do
+  [ -f "$work/run_int/metrics.csv" ] && [ "$(wc -l < "$work/run_int/metrics.csv")" -ge 3 ] && break
+  sleep 0.1
+done
+mpirun_pid=$(pgrep -f "^mpirun .*run_int" | head -n 1) || fail "no mpirun"
+kill -INT "$mpirun_pid"
+t0=$(date +%s)
+for _ in $(seq 1 150); do kill -0 "$launcher" 2> /dev/null || break; sleep 0.1; done
+kill -0 "$launcher" 2> /dev/null && { pkill -KILL -f "seed=$marker" || true; fail "the job still runs 15 s after Ctrl-C"; }
+sleep 0.5
+[ "$(job_processes)" -eq 0 ] || fail "$(job_processes) processes of the job are left after Ctrl-C"
+[ -f "$work/run_int/checkpoint.bin" ] || fail "no checkpoint after Ctrl-C"
+log "   every process gone $(( $(date +%s) - t0 )) s after Ctrl-C"
+echo "PASS"
