@@ -9,6 +9,9 @@
 //       --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <filesystem>
+
 #include "common/config/run_config.hpp"
 #include "common/task/registry.hpp"
 
@@ -75,8 +78,14 @@ void replay(benchmark::State& state, const std::string& name) {
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  for (const std::string& name : masa::task::registeredTasks()) {
-    if (name == "mjcf") continue;
+  // Every task config (configs/tasks/NAME.yaml: the shipped tasks and those written in YAML), not
+  // the registered task codes: "yaml" and "mjcf" are code for configs, not tasks of their own (the
+  // benchmark used to abort on them, "unknown task 'yaml'").
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(masa::config::defaultConfigsDir() + "/tasks"))
+    if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  for (const std::string& name : names) {
     benchmark::RegisterBenchmark(("PhysicsOnly/" + name).c_str(), replay<false>, name);
     benchmark::RegisterBenchmark(("TaskStep/" + name).c_str(), replay<true>, name);
   }

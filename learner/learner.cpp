@@ -105,9 +105,14 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
     policy_transport_ = std::make_unique<transport::Transport>(opt_.url, opt_.run_key);
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
 
-  if (rc_.runner.eval_every > 0 && isLeadRank()) {
-    eval_factory_ = std::make_unique<task::TaskFactory>(rc_.task, spec, rc_.env, rc_.origin);
-    columns_.progress_names = eval_factory_->create()->progressNames();
+  if (isLeadRank()) {
+    auto factory = std::make_unique<task::TaskFactory>(rc_.task, spec, rc_.env, rc_.origin);
+    const auto probe = factory->create();
+    has_success_ = probe->measuresSuccess();
+    if (rc_.runner.eval_every > 0) {
+      columns_.progress_names = probe->progressNames();
+      eval_factory_ = std::move(factory);
+    }
   }
 
   start_ = last_update_ = std::chrono::steady_clock::now();
@@ -297,7 +302,8 @@ void Learner::report() {
                       statsMessage(report_, columns_, run_id_, dropStats(), c.envs_stale, c.envs_overflow));
   appendMetricsRow((fs::path(dir_) / "metrics.csv").string(), report_, columns_);
   if (!curve_)
-    curve_ = std::make_unique<LearningCurve>(dir_, rc_.task + " / " + model::methodName(rc_.method), columns_.term_names);
+    curve_ = std::make_unique<LearningCurve>(dir_, rc_.task + " / " + model::methodName(rc_.method), columns_.term_names,
+                                             has_success_);
   if (rc_.runner.plot_every > 0 && updates_ % rc_.runner.plot_every == 0) curve_->renderAsync();
   if (opt_.verbose) printProgress(report_, columns_, max_updates_, update_interval_s_, rc_.runner.eval_episodes);
 }

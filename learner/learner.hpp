@@ -154,6 +154,7 @@ class Learner {
   // The task, built once, for the evaluations of runner.eval_every (null when they are off).
   std::unique_ptr<task::TaskFactory> eval_factory_;
   ReportColumns columns_;  // reward terms (from the first chunk) and the task's progress figures
+  bool has_success_ = true;  // the task measures success (the curve's success axis)
   std::function<void(int64_t)> checkpoint_hook_;
 };
 

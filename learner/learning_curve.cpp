@@ -39,7 +39,8 @@ std::string curveScriptHeader(const std::string& what, const std::string& writer
     << gnuplotQuoted(title)
     << "\n"
        "set grid\n"
-       "set key top left\n"
+       "# Legends under their panels, clear of the data.\n"
+       "set key below horizontal\n"
        "set xlabel "
     << gnuplotQuoted(xlabel)
     << "\n"
@@ -55,49 +56,55 @@ std::string curveScriptFooter() {
          "system(\"mv -f learning_curve.png.tmp learning_curve.png\")\n";
 }
 
-std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names) {
+std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names,
+                                bool has_success) {
   std::ostringstream g;
   std::string terms;
   for (const auto& t : term_names) terms += (terms.empty() ? "" : " ") + t;
-  g << curveScriptHeader("a masa run", "masa_learner", title, "env steps")
+  g << curveScriptHeader("a masa run", "masa_learner", title, "env steps (millions)")
     << "# Updates in which no episode ended have no return: the CSV says nan there.\n"
        "set title \"mean episode return\"\n"
-       "plot \"metrics.csv\" using \"env_steps\":\"return\" pt 7 lw 2 title \"return (training)\", \\\n"
-       "     \"\" using \"env_steps\":\"eval_return\" with points pt 5 ps 0.9 title \"return (policy mean)\"\n"
-       "set title \"mean episode length and success rate\"\n"
-       "set ytics nomirror\n"
-       "set y2tics\n"
-       "set y2range [0:1]\n"
-       "plot \"metrics.csv\" using \"env_steps\":\"length\" pt 7 title \"length\", \\\n"
-       "     \"\" using \"env_steps\":(column(\"success\") < 0 ? NaN : column(\"success\")) axes x1y2 pt 7 title \"success\"\n"
-       "unset y2tics\n"
-       "set ytics mirror\n"
-       "set title \"reward terms (mean per episode)\"\n"
-       "set key top left font \",8\"\n";
+       "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"return\" pt 7 lw 2 title \"return (training)\", \\\n"
+       "     \"\" using (column(\"env_steps\")/1e6):\"eval_return\" with points pt 5 ps 0.9 title \"return (policy mean)\"\n";
+  if (has_success)
+    g << "set title \"mean episode length and success rate\"\n"
+         "set ytics nomirror\n"
+         "set y2tics\n"
+         "set y2range [0:1]\n"
+         "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"length\" pt 7 title \"length\", \\\n"
+         "     \"\" using (column(\"env_steps\")/1e6):(column(\"success\") < 0 ? NaN : column(\"success\")) axes x1y2 pt 7 title \"success\"\n"
+         "unset y2tics\n"
+         "set ytics mirror\n";
+  else  // a task without a success measure (A1, humanoids, ant) gets no success axis
+    g << "set title \"mean episode length\"\n"
+         "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"length\" pt 7 title \"length\"\n";
+  g << "set title \"reward terms (mean per episode)\"\n"
+       "set key font \",8\"\n";
   if (term_names.empty())
-    g << "plot \"metrics.csv\" using \"env_steps\":\"return\" pt 7 title \"return\"\n";
+    g << "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"return\" pt 7 title \"return\"\n";
   else
-    g << "plot for [t in " << gnuplotQuoted(terms) << "] \"metrics.csv\" using \"env_steps\":(column(\"term_\".t)) pt 7 title t\n";
-  g << "set key top left font \",10\"\n"
+    g << "plot for [t in " << gnuplotQuoted(terms) << "] \"metrics.csv\" using (column(\"env_steps\")/1e6):(column(\"term_\".t)) pt 7 title t\n";
+  g << "set key font \",10\"\n"
        "set title \"losses\"\n"
-       "plot \"metrics.csv\" using \"env_steps\":\"actor_loss\" pt 7 title \"actor\", \\\n"
-       "     \"\" using \"env_steps\":\"critic_loss\" pt 7 title \"critic\"\n"
+       "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"actor_loss\" pt 7 title \"actor\", \\\n"
+       "     \"\" using (column(\"env_steps\")/1e6):\"critic_loss\" pt 7 title \"critic\"\n"
        "set title \"KL and learning rate\"\n"
        "set logscale y\n"
-       "plot \"metrics.csv\" using \"env_steps\":\"kl\" pt 7 title \"KL(old||new)\", \\\n"
-       "     \"\" using \"env_steps\":\"lr\" pt 7 title \"learning rate\"\n"
+       "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"kl\" pt 7 title \"KL(old||new)\", \\\n"
+       "     \"\" using (column(\"env_steps\")/1e6):\"lr\" pt 7 title \"learning rate\"\n"
        "unset logscale y\n"
        "set title \"throughput\"\n"
-       "plot \"metrics.csv\" using \"env_steps\":\"fps\" pt 7 title \"env steps / s\"\n"
+       "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"fps\" pt 7 title \"env steps / s\"\n"
     << curveScriptFooter();
   return g.str();
 }
 
-LearningCurve::LearningCurve(std::string run_dir, std::string title, std::vector<std::string> term_names)
+LearningCurve::LearningCurve(std::string run_dir, std::string title, std::vector<std::string> term_names,
+                             bool has_success)
     : dir_(std::move(run_dir)) {
   script_ = (fs::path(dir_) / "learning_curve.gp").string();
   png_ = (fs::path(dir_) / "learning_curve.png").string();
-  writeScript(term_names, title);
+  writeScript(term_names, title, has_success);
 }
 
 LearningCurve::LearningCurve(std::string run_dir, const Script& script) : dir_(std::move(run_dir)) {
@@ -108,8 +115,9 @@ LearningCurve::LearningCurve(std::string run_dir, const Script& script) : dir_(s
 
 LearningCurve::~LearningCurve() { reap(true); }
 
-void LearningCurve::writeScript(const std::vector<std::string>& term_names, const std::string& title) const {
-  std::ofstream(script_) << learningCurveScript(title, term_names);
+void LearningCurve::writeScript(const std::vector<std::string>& term_names, const std::string& title,
+                                bool has_success) const {
+  std::ofstream(script_) << learningCurveScript(title, term_names, has_success);
 }
 
 bool LearningCurve::reap(bool block) {

@@ -14,8 +14,9 @@ namespace masa::learner {
 
 class LearningCurve {
  public:
-  // term_names: the task's reward terms, as the metrics.csv columns term_<name>.
-  LearningCurve(std::string run_dir, std::string title, std::vector<std::string> term_names);
+  // term_names: the task's reward terms, as the metrics.csv columns term_<name>; has_success: the
+  // task measures success (Task::hasSuccessMeasure), so the length panel gets a success axis.
+  LearningCurve(std::string run_dir, std::string title, std::vector<std::string> term_names, bool has_success = true);
   // A run whose metrics.csv has other columns (masa_offline's): its own script, rendered the same way.
   struct Script {
     std::string text;
@@ -34,7 +35,7 @@ class LearningCurve {
   const std::string& pngPath() const { return png_; }
 
  private:
-  void writeScript(const std::vector<std::string>& term_names, const std::string& title) const;
+  void writeScript(const std::vector<std::string>& term_names, const std::string& title, bool has_success) const;
   bool reap(bool block);  // true when no render is running afterwards
   bool spawn();
 
@@ -55,6 +56,7 @@ std::string curveScriptFooter();
 std::string gnuplotQuoted(const std::string& s);
 
 // gnuplot script text for a metrics.csv with these reward terms (exposed for tests).
-std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names);
+std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names,
+                                bool has_success = true);
 
 }  // namespace masa::learner

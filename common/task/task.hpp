@@ -80,6 +80,9 @@ class Task {
   // error, seconds the pole stayed up), read at the end of an episode by evaluations. The names
   // carry their units and are the same for every episode.
   virtual std::vector<std::string> progressNames() const { return {}; }
+  // Whether episodes of this task end in success or failure (TriFinger: the goal pose reached);
+  // tasks that only score (the walkers) have no success to report or plot.
+  bool measuresSuccess() const { return hasSuccessMeasure(); }
   virtual void progress(double* out) const {}
 
   // Whole-state symmetry: the state becomes T_i of itself (then mj_forward). The verifier compares

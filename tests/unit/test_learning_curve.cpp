@@ -66,6 +66,32 @@ TEST(LearningCurve, RendersAPngFromMetricsWithEveryRewardTerm) {
   fs::remove_all(dir);
 }
 
+// Issue #31: the env-step ticks ran together ("1e+062e+06..."), legends lay over the curves, and a
+// task without success (the A1) had a success axis.
+TEST(LearningCurve, StepsInMillionsLegendsBelowTheDataAndASuccessAxisOnlyWhereTheTaskHasOne) {
+  const std::string with = learningCurveScript("trifinger_lift / masa", {"alive"}, true);
+  const std::string without = learningCurveScript("a1_beam / masa", {"alive"}, false);
+  for (const std::string* s : {&with, &without}) {
+    EXPECT_NE(s->find("env steps (millions)"), std::string::npos);
+    EXPECT_EQ(s->find("using \"env_steps\""), std::string::npos) << "every panel's x is in millions";
+    EXPECT_NE(s->find("set key below"), std::string::npos);
+    EXPECT_EQ(s->find("set key top"), std::string::npos);
+  }
+  EXPECT_NE(with.find("success"), std::string::npos);
+  EXPECT_NE(with.find("y2tics"), std::string::npos);
+  EXPECT_EQ(without.find("success"), std::string::npos) << without;
+  EXPECT_EQ(without.find("y2"), std::string::npos);
+  if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
+  for (bool has_success : {true, false}) {
+    const fs::path dir = freshDir(has_success ? "with_success" : "without_success");
+    writeMetrics(dir, 6);
+    LearningCurve curve(dir.string(), "a1_beam / masa", {"alive", "velocity"}, has_success);
+    EXPECT_TRUE(curve.renderAndWait()) << "gnuplot log: " << (dir / "learning_curve.log");
+    EXPECT_TRUE(isPng(curve.pngPath()));
+    fs::remove_all(dir);
+  }
+}
+
 TEST(LearningCurve, AsyncRenderDoesNotBlockAndIsCollectedByTheDestructor) {
   if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
   const fs::path dir = freshDir("async");
