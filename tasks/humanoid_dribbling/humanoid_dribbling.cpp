@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/core/config_error.hpp"
 #include "tasks/tasks.hpp"
 
 namespace masa::task {
@@ -33,6 +34,13 @@ HumanoidDribbling::HumanoidDribbling(std::shared_ptr<const MujocoModel> model, c
   ball_distance_ = params.positive("ball_distance", 0.6);
   fall_height_ = params.positive("fall_height", 0.4);
   max_ball_distance_ = params.positive("max_ball_distance", 5.0);
+  velocity_cap_ = params.number("velocity_cap", 0.0);
+  if (velocity_cap_ < 0.0) throw ConfigError(params.origin("velocity_cap"), "env.velocity_cap",
+                                             "must be 0 (uncapped) or a speed in m/s, got " + std::to_string(velocity_cap_));
+  const std::string lateral = params.text("lateral_penalty", "abs");
+  if (lateral != "abs" && lateral != "squared")
+    throw ConfigError(params.origin("lateral_penalty"), "env.lateral_penalty", "must be abs or squared, got '" + lateral + "'");
+  lateral_squared_ = lateral == "squared";
   segment_min_ = params.positive("segment_length_min", 4.0);
   segment_max_ = params.positive("segment_length_max", 8.0);
   turn_min_ = params.number("turn_min_deg", 30.0) * kDeg;
@@ -104,13 +112,13 @@ void HumanoidDribbling::computeRewardTerms(double* t) const {
   double v[2], r[9];
   f.rotateIn(ballLinVel(), v);
   torsoRotation(r);
-  t[0] = v[0];                                                          // velocity: ball along the segment
+  t[0] = velocity_cap_ > 0.0 ? std::min(v[0], velocity_cap_) : v[0];   // velocity: ball along the segment
   t[1] = 1.0;                                                           // alive
   t[2] = std::exp(-torsoBallDistance());                                // dist
   t[3] = std::cos(f.heading) * r[0] + std::sin(f.heading) * r[3];       // heading: torso x axis . segment
   t[4] = actionSquaredNorm();                                           // action
   t[5] = jointPower();                                                 // energy
-  t[6] = std::abs(v[1]);                                                // lateral: |ball lateral velocity|
+  t[6] = lateral_squared_ ? v[1] * v[1] : std::abs(v[1]);              // lateral: ball lateral velocity
 }
 
 bool HumanoidDribbling::isTerminated() const {

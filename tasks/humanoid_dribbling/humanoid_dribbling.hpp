@@ -43,6 +43,10 @@ class HumanoidDribbling final : public HumanoidTask {
   int ball_qpos_, ball_dof_;
   double ball_radius_;
   double ball_distance_, fall_height_, max_ball_distance_;
+  // Issue #31 (the kick): the ball's speed along the segment rewarded up to velocity_cap m/s (0:
+  // uncapped, the paper), and its lateral speed penalized squared instead of absolute.
+  double velocity_cap_ = 0.0;
+  bool lateral_squared_ = false;
   double segment_min_, segment_max_, turn_min_, turn_max_;
   std::vector<PlanarFrame> route_;
   std::vector<double> length_;

@@ -349,3 +349,48 @@ TEST(HumanoidDribblingTask, BallPositionDeclaredAxialFailsTheObservationMapNamin
 
 }  // namespace
 }  // namespace masa::task
+
+namespace masa::task {
+namespace {
+
+// Issue #31: the kick (ball speed paid without limit, the ball allowed 5 m away) beat dribbling.
+// env.velocity_cap caps the ball-speed term, env.lateral_penalty: squared squares the lateral one;
+// the paper's behaviour (uncapped, absolute) stays the default.
+TEST(HumanoidDribblingTask, TheKickOptionsCapTheBallSpeedRewardAndSquareTheLateralPenalty) {
+  const TaskFactory paper = quietFactory();
+  const TaskFactory capped = envFactory(kTask, editedEnv(kTask, [](YAML::Node& env) {
+                                          env["reset_noise"] = 0.0;
+                                          env["velocity_cap"] = 1.5;
+                                          env["lateral_penalty"] = "squared";
+                                        }));
+  for (const TaskFactory* f : {&paper, &capped}) {
+    auto t = f->create();
+    Rng rng(0);
+    t->reset(rng);
+    double* v = ballQvel(*t);
+    v[0] = 3.0;
+    v[1] = 0.8;
+    v[3] = -0.8 / 0.11;  // rolling without slipping
+    v[4] = 3.0 / 0.11;
+    ASSERT_FALSE(stepZero(*t).terminated);
+    if (f == &paper) {
+      EXPECT_NEAR(rewardTerm(*t, "velocity"), 2.0 * 3.0, 0.15);
+      EXPECT_NEAR(rewardTerm(*t, "lateral"), -0.5 * 0.8, 0.05);
+    } else {
+      EXPECT_DOUBLE_EQ(rewardTerm(*t, "velocity"), 2.0 * 1.5);  // capped: a faster ball earns no more
+      EXPECT_NEAR(rewardTerm(*t, "lateral"), -0.5 * 0.8 * 0.8, 0.05);
+    }
+  }
+  for (const auto& [key, value] : {std::pair<std::string, std::string>{"velocity_cap", "-1"},
+                                   {"lateral_penalty", "cubic"}}) {
+    try {
+      envFactory(kTask, editedEnv(kTask, [&](YAML::Node& env) { env[key] = value; }));
+      ADD_FAILURE() << key << "=" << value << " was accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("env." + key), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace masa::task
