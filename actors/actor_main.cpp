@@ -100,9 +100,8 @@ int main(int argc, char** argv) {
       opt.run_id = plan.run_id;
       opt.url = plan.url;
       // Actor i reports to learner rank i mod (number of ranks).
-      opt.rollout_url = job->learnerCount() > 1
-                            ? masa::transport::rankRolloutUrl(plan.url, opt.actor_id % job->learnerCount())
-                            : plan.url;
+      opt.rollout_url =
+          masa::transport::rankRolloutUrl(plan.url, opt.actor_id % job->learnerCount(), job->learnerCount());
       if (plan.key) {
         masa::transport::RunKey k;
         k.bytes = *plan.key;

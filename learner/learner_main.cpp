@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     opt.ranks = ranks;
     opt.rank_check_every = rank_check_every;
     opt.verbose = lead;
-    if (ranks) opt.rollout_url = masa::transport::rankRolloutUrl(url, ranks->rank());
+    if (ranks) opt.rollout_url = masa::transport::rankRolloutUrl(url, ranks->rank(), ranks->size());
     if (!resume_dir.empty()) {
       opt.resume = true;
       opt.run_dir = resume_dir;

@@ -69,7 +69,8 @@ RecvBufCheck checkRecvBuf(int64_t requested, const std::string& rmem_max_path) {
 
 namespace masa::transport {
 
-std::string rankRolloutUrl(const std::string& url, int rank) {
+std::string rankRolloutUrl(const std::string& url, int rank, int ranks) {
+  if (ranks == 1) return url;
   const std::string scheme = "udpm://";
   if (url.rfind(scheme, 0) != 0)
     throw std::invalid_argument("data-parallel learner ranks need a udpm:// URL for their own rollout channels, got '" +
@@ -88,7 +89,7 @@ std::string rankRolloutUrl(const std::string& url, int rank) {
     throw std::invalid_argument("'" + url + "' has no numeric port");
   }
   const int rank_port = port + 1 + rank;
-  if (rank < 0 || port <= 0 || rank_port > 65535)
+  if (rank < 0 || rank >= ranks || port <= 0 || rank_port > 65535)
     throw std::invalid_argument("'" + url + "': no port " + std::to_string(rank_port) + " for rank " + std::to_string(rank));
   return url.substr(0, colon + 1) + std::to_string(rank_port) + (end == std::string::npos ? "" : url.substr(end));
 }

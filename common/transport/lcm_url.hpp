@@ -44,11 +44,12 @@ RecvBufCheck checkRecvBuf(int64_t requested, const std::string& rmem_max_path = 
 
 namespace masa::transport {
 
-// The URL learner rank `rank` takes its actors' rollouts on, in a data-parallel run: LCM delivers
-// every channel of a multicast group and port to every socket subscribed there, so each rank's
-// share needs its own. udpm://G:P?opts -> udpm://G:(P + 1 + rank)?opts (the parameters stay on P,
-// which every actor hears). Throws std::invalid_argument for other providers (a tcpq hub relays
-// everything to everyone: give each rank its own hub instead).
-std::string rankRolloutUrl(const std::string& url, int rank);
+// The URL learner rank `rank` of `ranks` takes its actors' rollouts on (learner and actors both
+// ask this one function): LCM delivers every channel of a multicast group and port to every socket
+// subscribed there, so with several ranks each rank's share needs its own. One rank: `url` itself;
+// several: udpm://G:P?opts -> udpm://G:(P + 1 + rank)?opts (the parameters stay on P, which every
+// actor hears). Throws std::invalid_argument for other providers with several ranks (a tcpq hub
+// relays everything to everyone: give each rank its own hub instead).
+std::string rankRolloutUrl(const std::string& url, int rank, int ranks);
 
 }  // namespace masa::transport

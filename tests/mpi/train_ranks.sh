@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Training as one MPI job (issue #30): 2 learner ranks and 2 actors started by mpirun (MPMD), over
 # real LCM on loopback multicast, each actor feeding its own rank's URL.
+#  0. One learner rank and one actor train (the actor sent to the job's URL while a lone learner
+#     rank listened on its rank port: it hung before the fix).
 #  1. The job trains to --max-updates and every process exits 0: the actors stop when the learner
 #     ranks end training. metrics.csv has one row per update and counts the env steps of both
 #     ranks; the ranks checked their parameter hashes (every 2 updates) without a mismatch.
@@ -27,6 +29,12 @@ job() {  # job UPDATES [extra learner args]: 2 learner ranks, 2 actors of 8 envi
   timeout 120 "$mpirun_sh" -np 2 "$learner_bin" "${sets[@]}" --url "$url" --max-updates "$updates" --rank-check-every 2 "$@" \
     : -np 2 "$actor_bin" "${sets[@]}" --num-envs 8 --await-params-s 5
 }
+
+log "0. one learner rank and one actor under mpirun, 3 updates"
+timeout 60 "$mpirun_sh" -np 1 "$learner_bin" "${sets[@]}" --url "$url" --max-updates 3 --run-dir "$work/run1" \
+  : -np 1 "$actor_bin" "${sets[@]}" --num-envs 16 > "$work/job0.log" 2>&1 || fail "one rank: the job failed or hung"
+[ "$(($(wc -l < "$work/run1/metrics.csv") - 1))" -eq 3 ] || fail "one rank: not 3 updates"
+log "   3 updates (the actor sends where the one learner listens)"
 
 log "1. 2 learner ranks + 2 actors, 6 updates"
 job 6 --run-dir "$work/run" > "$work/job1.log" 2>&1 || fail "the job failed or hung (exit $?)"
