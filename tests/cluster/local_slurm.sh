@@ -29,6 +29,8 @@ local_slurm_start() {
   cpus=$(nproc)
   mem=$(( $(awk '/MemTotal/ {print $2}' /proc/meminfo) / 1024 * 8 / 10 ))
   # Ports of their own, so that a cluster of an earlier run or another test does not answer.
+  # proctrack/pgid: with proctrack/linuxproc, scancel ended the step while two actors of the job
+  # lived on (measured); real clusters use proctrack/cgroup, which a container cannot set up.
   local port=$(( 16800 + RANDOM % 400 * 2 ))
   cat > "$slurm_dir/slurm.conf" << CONF
 ClusterName=masatest
