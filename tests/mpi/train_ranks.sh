@@ -55,36 +55,35 @@ rows=$(($(wc -l < "$work/run/metrics.csv") - 1))
 [ "$rows" -eq 9 ] || fail "after resuming metrics.csv has $rows rows, expected 9"
 log "   resumed from 6 to 9"
 
+# start_long_job NAME: a job of 1000 updates in the background (launcher=its pid), returning once
+# it has made 2 updates. stop_and_check WHAT: after the fault, the job must be gone within 15 s.
+start_long_job() {
+  job 1000 --run-dir "$work/$1" > "$work/$1.log" 2>&1 &
+  launcher=$!
+  for _ in $(seq 1 300); do
+    [ -f "$work/$1/metrics.csv" ] && [ "$(wc -l < "$work/$1/metrics.csv")" -ge 3 ] && break
+    sleep 0.1
+  done
+  t0=$(date +%s)
+}
+stop_and_check() {
+  for _ in $(seq 1 150); do kill -0 "$launcher" 2> /dev/null || break; sleep 0.1; done
+  kill -0 "$launcher" 2> /dev/null && { pkill -KILL -f "seed=$marker" || true; fail "the job still runs 15 s after $1"; }
+  sleep 0.5
+  [ "$(job_processes)" -eq 0 ] || fail "$(job_processes) processes of the job are left after $1"
+  log "   every process gone $(( $(date +%s) - t0 )) s after $1"
+}
+
 log "3. a learner rank killed with SIGKILL ends the job"
-( job 1000 --run-dir "$work/run_kill" > "$work/job3.log" 2>&1 ) &
-launcher=$!
-for _ in $(seq 1 300); do
-  [ -f "$work/run_kill/metrics.csv" ] && [ "$(wc -l < "$work/run_kill/metrics.csv")" -ge 3 ] && break
-  sleep 0.1
-done
+start_long_job run_kill
 victim=$(pgrep -f "^$learner_bin .*run_kill" | tail -n 1) || fail "no learner rank to kill"
 kill -KILL "$victim"
-t0=$(date +%s)
-for _ in $(seq 1 100); do kill -0 "$launcher" 2> /dev/null || break; sleep 0.1; done
-kill -0 "$launcher" 2> /dev/null && { pkill -KILL -f "run_kill" || true; fail "the job still runs 10 s after a rank was killed"; }
-sleep 0.5
-[ "$(job_processes)" -eq 0 ] || fail "$(job_processes) processes of the job are left"
-log "   the job ended $(( $(date +%s) - t0 )) s after the kill, nothing left"
+stop_and_check "a rank was killed"
 
 log "4. Ctrl-C of mpirun"
-job 1000 --run-dir "$work/run_int" > "$work/job4.log" 2>&1 &
-launcher=$!
-for _ in $(seq 1 300); do
-  [ -f "$work/run_int/metrics.csv" ] && [ "$(wc -l < "$work/run_int/metrics.csv")" -ge 3 ] && break
-  sleep 0.1
-done
+start_long_job run_int
 mpirun_pid=$(pgrep -f "^mpirun .*run_int" | head -n 1) || fail "no mpirun"
 kill -INT "$mpirun_pid"
-t0=$(date +%s)
-for _ in $(seq 1 150); do kill -0 "$launcher" 2> /dev/null || break; sleep 0.1; done
-kill -0 "$launcher" 2> /dev/null && { pkill -KILL -f "seed=$marker" || true; fail "the job still runs 15 s after Ctrl-C"; }
-sleep 0.5
-[ "$(job_processes)" -eq 0 ] || fail "$(job_processes) processes of the job are left after Ctrl-C"
+stop_and_check "Ctrl-C"
 [ -f "$work/run_int/checkpoint.bin" ] || fail "no checkpoint after Ctrl-C"
-log "   every process gone $(( $(date +%s) - t0 )) s after Ctrl-C"
 echo "PASS"
