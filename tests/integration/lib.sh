@@ -83,13 +83,15 @@ set_auth() {
   auth=(--key-file "$work/run.key")
 }
 
-# start_learner RUN_DIR URL RUN_ID [extra args...]: a learner in the background, log in RUN_DIR/../learner.log.
+# start_learner RUN_DIR URL RUN_ID [extra args...]: a learner in the background, log in
+# $learner_log_file (default $work/learner.log; a test that runs several learners names each one's
+# here, since moving the file after the start raced with the learner's shell opening it).
 start_learner() {
   local dir=$1 url=$2 rid=$3
   shift 3
   set_auth "$@"
   "$learner_bin" "${test_sets[@]}" --url "$url" --run-id "$rid" --run-dir "$dir" --max-updates 100000 "${auth[@]+"${auth[@]}"}" "$@" \
-    > "$work/learner.log" 2>&1 &
+    > "${learner_log_file:-$work/learner.log}" 2>&1 &
   learner_pid=$!
   started_pids+=("$learner_pid")
 }

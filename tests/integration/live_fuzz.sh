@@ -25,9 +25,8 @@ fuzzed_run() {
   local name=$1
   shift
   run="$work/$name"
-  start_learner "$run" "$url" "$run_id" "$@"
   learner_log="$work/$name.learner.log"
-  mv "$work/learner.log" "$learner_log"  # the learner goes on writing to it
+  learner_log_file=$learner_log start_learner "$run" "$url" "$run_id" "$@"
   start_actor 0 "$url" "$run_id" "$@"
   a0=$actor_pid
   start_actor 1 "$url" "$run_id" "$@"
