@@ -12,6 +12,7 @@
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::actor {
 namespace {
@@ -66,7 +67,7 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
   drop_rng_.seed(options_.drop_seed);
 
   const auto spec = sym::SymmetrySpec::load(config_.spec_path);
-  factory_ = std::make_unique<task::TaskFactory>(config_.task, spec, config_.env, config_.origin);
+  factory_ = std::make_unique<task::TaskFactory>(task::taskCatalog(), config_.task, spec, config_.env, config_.origin);
   envs_.reserve(num_envs_);
   rngs_.reserve(num_envs_);
   for (int e = 0; e < num_envs_; ++e) {

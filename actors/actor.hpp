@@ -21,7 +21,7 @@
 
 #include "common/config/run_config.hpp"
 #include "common/model/actor_critic.hpp"
-#include "common/task/registry.hpp"
+#include "common/sim/registry.hpp"
 #include "actors/await_budget.hpp"
 #include "common/rollout/rollout.hpp"
 #include "actors/rollout_chunker.hpp"

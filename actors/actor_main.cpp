@@ -16,7 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "actors/actor.hpp"
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/cluster/job_plan.hpp"
 #include "common/cluster/mpi_job.hpp"

@@ -5,7 +5,7 @@
 #include <string_view>
 
 #include "common/core/check.hpp"
-#include "common/rollout/chunk_layout.hpp"
+#include "common/transport/chunk_layout.hpp"
 
 namespace masa::actor {
 

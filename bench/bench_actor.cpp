@@ -28,8 +28,9 @@
 
 #include "actors/actor.hpp"
 #include "common/config/run_config.hpp"
-#include "common/task/registry.hpp"
+#include "common/sim/registry.hpp"
 #include "common/transport/transport.hpp"
+#include "tasks/tasks.hpp"
 
 namespace {
 
@@ -226,7 +227,7 @@ const Recording& recording(const std::string& name) {
   if (it != cache.end()) return it->second;
   Recording& r = cache[name];
   const auto rc = runConfig(name);
-  r.factory = std::make_unique<task::TaskFactory>(rc.task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin);
+  r.factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin);
   auto env = r.factory->create();
   r.frame_skip = static_cast<int>(std::lround(env->controlTimestep() / env->model()->opt.timestep));
   mjcb_control = recordCtrl;
@@ -302,7 +303,7 @@ void actorLoop(benchmark::State& state, const std::string& name) {
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  for (const std::string& name : masa::task::registeredTasks()) {
+  for (const std::string& name : masa::task::taskCatalog().names()) {
     if (name == "mjcf") continue;
     benchmark::RegisterBenchmark(("RawPhysics/" + name).c_str(), rawPhysics, name);
     benchmark::RegisterBenchmark(("TaskStep/" + name).c_str(), taskStep, name);

@@ -6,6 +6,7 @@
 
 #include "common/policy/policy_file.hpp"
 #include "deploy/runner/policy_runner.hpp"
+#include "tasks/tasks.hpp"
 
 namespace {
 
@@ -16,7 +17,7 @@ void BM_DeployPolicyCommand(benchmark::State& st) {
   c.calibration_settle_s = 0;
   c.calibration_max_rate = 100;
   deploy::PolicyRunner r(lp, c, 1);
-  task::TaskFactory factory(lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source);
+  task::TaskFactory factory(task::taskCatalog(), lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source);
   auto sim = factory.create();
   Rng rng(0);
   sim->reset(rng);

@@ -13,7 +13,8 @@
 #include <filesystem>
 
 #include "common/config/run_config.hpp"
-#include "common/task/registry.hpp"
+#include "common/sim/registry.hpp"
+#include "tasks/tasks.hpp"
 
 namespace {
 
@@ -30,7 +31,7 @@ struct Replay {
 
 Replay record(const std::string& name) {
   const auto rc = config::loadRunConfig(config::defaultConfigsDir(), {"task=" + name});
-  Replay r{std::make_unique<task::TaskFactory>(rc.task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin), {}, {}};
+  Replay r{std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin), {}, {}};
   auto env = r.factory->create();
   Rng act_rng(kSeed + 1), reset_rng(kSeed);
   std::uniform_real_distribution<float> u(-1, 1);

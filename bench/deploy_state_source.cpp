@@ -14,11 +14,12 @@
 #include <vector>
 
 #include "common/policy/policy_file.hpp"
-#include "common/task/registry.hpp"
+#include "common/sim/registry.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_robot_command.hpp"
 #include "masa/lcmt_robot_state.hpp"
+#include "tasks/tasks.hpp"
 
 using namespace masa;
 
@@ -31,7 +32,7 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", seconds)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   policy::LoadedPolicy lp = policy::loadPolicyFile(policy_path);
-  task::TaskFactory factory(lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source);
+  task::TaskFactory factory(task::taskCatalog(), lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source);
   auto sim = factory.create();
   Rng rng(0);
   sim->reset(rng);

@@ -14,13 +14,14 @@
 #include "common/cluster/rank_agreement.hpp"
 #include "common/core/check.hpp"
 #include "common/policy/policy_file.hpp"
-#include "common/task/policy_evaluator.hpp"
+#include "common/sim/policy_evaluator.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/intake/drop_reason.hpp"
 #include "learner/metrics_csv.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "masa/lcmt_policy_params.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::learner {
 
@@ -106,7 +107,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
 
   if (isLeadRank()) {
-    auto factory = std::make_unique<task::TaskFactory>(rc_.task, spec, rc_.env, rc_.origin);
+    auto factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc_.task, spec, rc_.env, rc_.origin);
     const auto probe = factory->create();
     has_success_ = probe->measuresSuccess();
     if (rc_.runner.eval_every > 0) {

@@ -25,7 +25,7 @@
 #include "common/config/run_config.hpp"
 #include "common/model/actor_critic.hpp"
 #include "common/nn/adam.hpp"
-#include "common/task/registry.hpp"
+#include "common/sim/registry.hpp"
 #include "common/transport/transport.hpp"
 #include "learner/intake/batch_collector.hpp"
 #include "learner/intake/rollout_assembler.hpp"

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
 #include "common/cluster/job_plan.hpp"

@@ -16,4 +16,9 @@ const std::vector<TaskInfo>& taskList() {
   return list;
 }
 
+TaskCatalog& taskCatalog() {
+  static TaskCatalog catalog(taskList());
+  return catalog;
+}
+
 }  // namespace masa::task

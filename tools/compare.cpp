@@ -21,8 +21,8 @@
 #include <regex>
 #include <sstream>
 
-#include "common/build_info/build_info.hpp"
-#include "common/stats/summary_stats.hpp"
+#include "common/core/build_info.hpp"
+#include "common/core/summary_stats.hpp"
 
 using namespace masa;
 namespace fs = std::filesystem;

@@ -4,7 +4,7 @@
 #include <iostream>
 
 #include "common/config/run_config.hpp"
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 

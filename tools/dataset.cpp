@@ -18,7 +18,7 @@
 #include <numeric>
 #include <regex>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
 #include "common/dataset/dataset_log.hpp"
 #include "common/dataset/hdf5_export.hpp"
@@ -27,6 +27,7 @@
 #include "common/transport/channels.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/transport.hpp"
+#include "tasks/tasks.hpp"
 
 using namespace masa;
 namespace fs = std::filesystem;
@@ -54,7 +55,7 @@ struct Recording {
 Recording recordPolicy(const std::string& policy_file, const std::string& name, int episodes, uint64_t seed,
                        bool mean, int threads, dataset::DatasetLogWriter& writer, lcm::LCM* lcm, int max_steps = 0) {
   policy::LoadedPolicy p = policy::loadPolicyFile(policy_file);
-  task::TaskFactory factory(p.config.task, p.spec, p.config.env, p.config.origin);
+  task::TaskFactory factory(task::taskCatalog(), p.config.task, p.spec, p.config.env, p.config.origin);
   dataset::RecordOptions o;
   o.eval.episodes = episodes;
   o.eval.seed = seed;

@@ -14,14 +14,15 @@
 #include <fstream>
 #include <iostream>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/core/config_error.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/render/offscreen_renderer.hpp"
 #include "common/render/strip_sampler.hpp"
-#include "common/task/policy_evaluator.hpp"
+#include "common/sim/policy_evaluator.hpp"
 #include "learner/checkpoint.hpp"
+#include "tasks/tasks.hpp"
 
 using namespace masa;
 namespace fs = std::filesystem;
@@ -163,7 +164,7 @@ int main(int argc, char** argv) {
   try {
     policy::LoadedPolicy p = loadTarget(target, overrides);
     const double sym_error = policy::checkPolicySymmetry(p);
-    task::TaskFactory factory(p.config.task, p.spec, p.config.env, p.config.origin);
+    task::TaskFactory factory(task::taskCatalog(), p.config.task, p.spec, p.config.env, p.config.origin);
     std::printf("%s / %s from %s, %d episode(s), %s actions, seeds %llu..%llu\n", p.config.task.c_str(),
                 model::methodName(p.config.method).c_str(), target.c_str(), o.episodes,
                 o.deterministic ? "mean" : "sampled", static_cast<unsigned long long>(o.seed),

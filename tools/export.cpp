@@ -13,7 +13,7 @@
 #include <iostream>
 #include <random>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/onnx/policy_onnx.hpp"
 #include "common/policy/policy_file.hpp"
 

@@ -22,7 +22,7 @@
 #include <unordered_set>
 #include <vector>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/transport/message_mutator.hpp"
 
 namespace {

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/message_auth.hpp"

@@ -15,7 +15,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
 #include "common/dataset/dataset_log.hpp"
 #include "common/policy/policy_file.hpp"

@@ -9,14 +9,15 @@
 #include <fstream>
 #include <iostream>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/core/config_error.hpp"
 #include "common/model/actor_critic.hpp"
 #include "common/model/diag_gaussian.hpp"
 #include "common/render/offscreen_renderer.hpp"
 #include "common/render/strip_sampler.hpp"
-#include "common/task/registry.hpp"
+#include "common/sim/registry.hpp"
+#include "tasks/tasks.hpp"
 
 using namespace masa;
 
@@ -48,7 +49,7 @@ int main(int argc, char** argv) {
     overrides.insert(overrides.begin(), "task=" + task_name);
     const auto rc = config::loadRunConfig(config::defaultConfigsDir(), overrides);
     const auto spec = sym::SymmetrySpec::load(rc.spec_path);
-    task::TaskFactory factory(rc.task, spec, rc.env, rc.origin);
+    task::TaskFactory factory(task::taskCatalog(), rc.task, spec, rc.env, rc.origin);
     auto env = factory.create();
 
     std::unique_ptr<model::ActorCritic<float>> policy;

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
 #include "common/model/equivariance_check.hpp"
 #include "common/symmetry/symmetry_spec.hpp"

@@ -9,10 +9,10 @@
 #include <fstream>
 #include <iostream>
 
-#include "common/build_info/build_info.hpp"
-#include "common/task/found_spec_writer.hpp"
-#include "common/task/symmetry_candidate_check.hpp"
-#include "common/task/symmetry_finder.hpp"
+#include "common/core/build_info.hpp"
+#include "common/physics_symmetry/found_spec_writer.hpp"
+#include "common/physics_symmetry/symmetry_candidate_check.hpp"
+#include "common/physics_symmetry/symmetry_finder.hpp"
 
 using namespace masa;
 

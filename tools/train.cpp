@@ -18,7 +18,7 @@
 
 #include "actors/actor.hpp"
 #include "actors/environments_snapshot.hpp"
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
 #include "learner/learner.hpp"

@@ -8,11 +8,12 @@
 #include <filesystem>
 #include <iostream>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/core/config_error.hpp"
-#include "common/task/imperfection_report.hpp"
-#include "common/task/symmetry_verifier.hpp"
+#include "common/physics_symmetry/imperfection_report.hpp"
+#include "common/physics_symmetry/symmetry_verifier.hpp"
+#include "tasks/tasks.hpp"
 
 using namespace masa;
 
@@ -47,7 +48,7 @@ int main(int argc, char** argv) {
       overrides.insert(overrides.begin(), "task=" + task_name);
       const auto rc = config::loadRunConfig(config::defaultConfigsDir(), overrides);
       const auto spec = sym::SymmetrySpec::load(spec_file.empty() ? rc.spec_path : spec_file);
-      factory = std::make_unique<task::TaskFactory>(rc.task, spec, rc.env, rc.origin);
+      factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, spec, rc.env, rc.origin);
     } else {
       if (spec_file.empty()) {
         std::cerr << "masa_verify: --model needs --spec\n";
@@ -56,7 +57,7 @@ int main(int argc, char** argv) {
       YAML::Node env;
       // Relative to where the user stands, not to the source tree (the registry's base for its tasks).
       env["model_file"] = std::filesystem::absolute(model_file).string();
-      factory = std::make_unique<task::TaskFactory>("mjcf", sym::SymmetrySpec::load(spec_file), env,
+      factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), "mjcf", sym::SymmetrySpec::load(spec_file), env,
                                                     std::map<std::string, std::string>{}, "command line");
     }
     const auto report = task::verifySymmetry(*factory, opt);

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
 
 namespace masa::config {

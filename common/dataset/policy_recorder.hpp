@@ -8,7 +8,7 @@
 
 #include "common/dataset/episode_record.hpp"
 #include "common/model/actor_critic.hpp"
-#include "common/task/policy_evaluator.hpp"
+#include "common/sim/policy_evaluator.hpp"
 
 namespace masa::dataset {
 

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/model/agent_maps.hpp"
 #include "common/onnx/onnx_graph.hpp"
 

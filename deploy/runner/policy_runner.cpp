@@ -1,4 +1,5 @@
 #include "deploy/runner/policy_runner.hpp"
+#include "tasks/tasks.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -39,7 +40,7 @@ const char* modeName(Mode m) {
 
 PolicyRunner::PolicyRunner(policy::LoadedPolicy& policy, const DeployConfig& config, int64_t runner_id)
     : cfg_(config), runner_id_(runner_id), model_(policy.model.get()) {
-  factory_ = std::make_unique<task::TaskFactory>(policy.config.task, policy.spec, policy.config.env,
+  factory_ = std::make_unique<task::TaskFactory>(task::taskCatalog(), policy.config.task, policy.spec, policy.config.env,
                                                  policy.config.origin, policy.source);
   task_ = factory_->create();
   const std::string gap = task_->measuredStateGap();

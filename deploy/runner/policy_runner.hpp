@@ -29,7 +29,7 @@
 
 #include "common/core/types.hpp"
 #include "common/policy/policy_file.hpp"
-#include "common/task/registry.hpp"
+#include "common/sim/registry.hpp"
 #include "deploy/runner/deploy_config.hpp"
 #include "masa/lcmt_robot_command.hpp"
 #include "masa/lcmt_robot_state.hpp"

@@ -17,7 +17,7 @@
 #include <thread>
 #include <vector>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/transport/transport.hpp"
 #include "deploy/runner/deploy_config.hpp"

@@ -23,13 +23,14 @@
 #include <thread>
 #include <vector>
 
-#include "common/build_info/build_info.hpp"
+#include "common/core/build_info.hpp"
 #include "common/policy/policy_file.hpp"
-#include "common/task/registry.hpp"
+#include "common/sim/registry.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_robot_command.hpp"
 #include "masa/lcmt_robot_state.hpp"
+#include "tasks/tasks.hpp"
 
 using namespace masa;
 using Clock = std::chrono::steady_clock;
@@ -78,7 +79,7 @@ int main(int argc, char** argv) {
 
   try {
     policy::LoadedPolicy lp = policy::loadPolicyFile(policy_path);
-    task::TaskFactory factory(lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source);
+    task::TaskFactory factory(task::taskCatalog(), lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source);
     std::unique_ptr<task::Task> task = factory.create();
     Rng rng(seed);
     task->reset(rng);

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "common/core/check.hpp"
-#include "common/rollout/chunk_layout.hpp"
+#include "common/transport/chunk_layout.hpp"
 
 namespace masa::learner {
 
@@ -87,7 +87,7 @@ DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
   // Length fields against the dimensions, and every array against its length field (a message
   // built in-process can disagree; a decoded one cannot).
   // The counts first (they are part of the shape), then every length field against the one table
-  // of what a chunk of this shape holds (common/rollout/chunk_layout.hpp).
+  // of what a chunk of this shape holds (common/transport/chunk_layout.hpp).
   const int64_t steps = T * n;
   if (m.num_final < 0 || m.num_final > steps || m.num_episodes < 0 || m.num_episodes > steps || m.num_terms < 0 ||
       m.num_terms > cfg_.max_terms) {

@@ -15,6 +15,7 @@
 #include "learner/offline/normalizer_fit.hpp"
 #include "learner/offline/offline_curve.hpp"
 #include "learner/offline/symmetry_augmentation.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::offline {
 namespace fs = std::filesystem;
@@ -91,7 +92,7 @@ struct OfflineRun::Impl {
       figures = {"mean_q", "mean_v", "mean_advantage", "mean_weight"};
     }
     sums.assign(losses.size() + figures.size() + (iql ? 1 : 0), 0.0);
-    factory = std::make_unique<task::TaskFactory>(rc.task, spec, rc.env, rc.origin);
+    factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, spec, rc.env, rc.origin);
     progress_names = factory->create()->progressNames();
     openRunDir();
   }

@@ -18,7 +18,7 @@
 
 #include "common/config/run_config.hpp"
 #include "common/dataset/transition_dataset.hpp"
-#include "common/task/policy_evaluator.hpp"
+#include "common/sim/policy_evaluator.hpp"
 #include "learner/offline/offline_config.hpp"
 
 namespace masa::offline {

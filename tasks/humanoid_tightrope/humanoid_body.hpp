@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "common/core/check.hpp"
-#include "common/task/task.hpp"
+#include "common/sim/task.hpp"
 
 namespace masa::task {
 

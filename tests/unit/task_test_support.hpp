@@ -22,8 +22,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include "common/config/run_config.hpp"
-#include "common/task/registry.hpp"
-#include "common/task/symmetry_verifier.hpp"
+#include "common/sim/registry.hpp"
+#include "common/physics_symmetry/symmetry_verifier.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::test {
 
@@ -69,7 +70,7 @@ sym::SymmetrySpec editedSpec(const std::string& task, Edit edit) {
 
 // A factory straight from an env node (no run-config defaults, no origins for error messages).
 inline task::TaskFactory envFactory(const std::string& task, const YAML::Node& env, const sym::SymmetrySpec& spec) {
-  return task::TaskFactory(task, spec, env);
+  return task::TaskFactory(task::taskCatalog(), task, spec, env);
 }
 inline task::TaskFactory envFactory(const std::string& task, const YAML::Node& env) {
   return envFactory(task, env, shippedSpec(task));
@@ -82,12 +83,12 @@ inline task::TaskFactory runConfigFactory(const std::string& task, const std::ve
   std::vector<std::string> all = {"task=" + task};
   all.insert(all.end(), overrides.begin(), overrides.end());
   const config::RunConfig rc = config::loadRunConfig(configsDir(), all);
-  return task::TaskFactory(task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin);
+  return task::TaskFactory(task::taskCatalog(), task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin);
 }
 // The same with another spec in place of the shipped one.
 inline task::TaskFactory runConfigFactory(const std::string& task, const sym::SymmetrySpec& spec) {
   const config::RunConfig rc = config::loadRunConfig(configsDir(), {"task=" + task});
-  return task::TaskFactory(task, spec, rc.env, rc.origin);
+  return task::TaskFactory(task::taskCatalog(), task, spec, rc.env, rc.origin);
 }
 
 // ---- Reading and driving a task --------------------------------------------------------------

@@ -1,4 +1,4 @@
-// The one table of what a rollout chunk holds (common/rollout/chunk_layout.hpp) against the wire
+// The one table of what a rollout chunk holds (common/transport/chunk_layout.hpp) against the wire
 // table (which a hash test ties to lcm-gen), lcm-gen's own encoder, and the learner's validator.
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <string>
 
 #include "actors/rollout_chunker.hpp"
-#include "common/rollout/chunk_layout.hpp"
+#include "common/transport/chunk_layout.hpp"
 #include "learner/intake/rollout_assembler.hpp"
 #include "masa/lcmt_rollout_chunk.hpp"
 #include "test_transport_support.hpp"

@@ -15,6 +15,7 @@
 #include "common/dataset/policy_recorder.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/transport/channels.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::dataset {
 namespace {
@@ -265,7 +266,7 @@ TEST(DatasetHdf5, ExportReadsBackExactly) {
 
 TEST(DatasetRecorder, EpisodesAreTheEvaluatorsAndRepeatFromTheSeed) {
   policy::LoadedPolicy p = policy::loadPolicyFile(std::string(MASA_SOURCE_DIR) + "/tasks/a1_beam/policy/policy.bin");
-  task::TaskFactory factory(p.config.task, p.spec, p.config.env, p.config.origin);
+  task::TaskFactory factory(task::taskCatalog(), p.config.task, p.spec, p.config.env, p.config.origin);
   RecordOptions o;
   o.eval.episodes = 3;
   o.eval.seed = 11;

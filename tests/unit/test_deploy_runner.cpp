@@ -20,6 +20,7 @@
 #include "deploy/runner/deploy_config.hpp"
 #include "deploy/runner/policy_runner.hpp"
 #include "deploy/runner/realtime.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::deploy {
 namespace {
@@ -52,7 +53,7 @@ masa::lcmt_robot_state stateOf(const task::Task& t, int64_t utime) {
 
 struct Fixture {
   policy::LoadedPolicy lp = policy::loadPolicyFile(kPolicy);
-  task::TaskFactory factory{lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source};
+  task::TaskFactory factory{task::taskCatalog(), lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source};
   std::unique_ptr<task::Task> sim = factory.create();
   Fixture() {
     Rng rng(0);
@@ -125,7 +126,7 @@ TEST(DeployRunner, FreezesItsPolicyAndActsWithTheBitsOfTheUnfrozenPolicy) {
 TEST(DeployRunner, HumanoidJointCommandIsTheTasksMotorTorqueAndItsObservationTheTasksOwn) {
   policy::LoadedPolicy lp =
       policy::loadPolicyFile(std::string(MASA_SOURCE_DIR) + "/tasks/humanoid_tightrope/policy/policy.bin");
-  task::TaskFactory factory{lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source};
+  task::TaskFactory factory{task::taskCatalog(), lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source};
   std::unique_ptr<task::Task> sim = factory.create(), robot_side = factory.create();
   Rng rng(5);
   sim->reset(rng);

@@ -10,7 +10,8 @@
 
 #include "common/config/run_config.hpp"
 #include "common/policy/policy_file.hpp"
-#include "common/task/policy_evaluator.hpp"
+#include "common/sim/policy_evaluator.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::policy {
 namespace {
@@ -99,7 +100,7 @@ TEST(PolicyEvaluator, EpisodesDependOnTheirSeedsOnlyNotOnTheBatchOrThreads) {
   model::ActorCritic<float> m(spec, rc.model);
   Rng rng(9);
   m.initialize(rng);
-  task::TaskFactory factory(rc.task, spec, rc.env, rc.origin);
+  task::TaskFactory factory(task::taskCatalog(), rc.task, spec, rc.env, rc.origin);
   task::PolicyEvaluator ev(factory, m);
   task::EvalOptions o;
   o.episodes = 4;
@@ -140,7 +141,7 @@ TEST(ShippedPolicies, EveryTaskShipsAPolicyThatLoadsChecksAndRuns) {
     if (p.config.method == model::Method::kMasa) {
       EXPECT_LT(checkPolicySymmetry(p), 1e-4);
     }
-    task::TaskFactory factory(p.config.task, p.spec, p.config.env, p.config.origin);
+    task::TaskFactory factory(task::taskCatalog(), p.config.task, p.spec, p.config.env, p.config.origin);
     task::PolicyEvaluator ev(factory, *p.model);
     task::EvalOptions o;
     o.episodes = 1;

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "common/stats/summary_stats.hpp"
+#include "common/core/summary_stats.hpp"
 
 using namespace masa::stats;
 

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <regex>
 
-#include "common/task/imperfection_report.hpp"
+#include "common/physics_symmetry/imperfection_report.hpp"
 #include "task_test_support.hpp"
 
 namespace masa::task {
@@ -24,7 +24,7 @@ std::string walkerSpecText() { return readTextFile(kData + "/c4_walker_spec.yaml
 TaskFactory walker(const std::string& spec_text, const std::string& model_file = kData + "/c4_walker.xml") {
   YAML::Node env;
   env["model_file"] = model_file;
-  return TaskFactory("mjcf", sym::SymmetrySpec::parseString(spec_text, "walker.yaml"), env, {}, "test");
+  return TaskFactory(taskCatalog(), "mjcf", sym::SymmetrySpec::parseString(spec_text, "walker.yaml"), env, {}, "test");
 }
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {

@@ -7,11 +7,12 @@
 #include <fstream>
 #include <map>
 
-#include "common/task/found_spec_writer.hpp"
-#include "common/task/joint_slot_names.hpp"
-#include "common/task/symmetry_candidate_check.hpp"
-#include "common/task/symmetry_finder.hpp"
+#include "common/physics_symmetry/found_spec_writer.hpp"
+#include "common/physics_symmetry/joint_slot_names.hpp"
+#include "common/physics_symmetry/symmetry_candidate_check.hpp"
+#include "common/physics_symmetry/symmetry_finder.hpp"
 #include "task_test_support.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::task {
 namespace {
@@ -163,7 +164,7 @@ TEST(SymmetryFinder, TheWrittenTaskConfigBuildsAYamlTaskOverTheWrittenSpec) {
   EXPECT_EQ(config["spec"].as<std::string>(), spec_path);
   EXPECT_EQ(config["env"]["task_code"].as<std::string>(), "yaml");
   const auto spec = sym::SymmetrySpec::load(spec_path);
-  const TaskFactory factory("found_humanoid", spec, config["env"], {}, "test");
+  const TaskFactory factory(task::taskCatalog(), "found_humanoid", spec, config["env"], {}, "test");
   const auto t = factory.create();
   // The base (height, velocities, quaternion: 11), the abdomen (9) and 2 limbs of 27, as the shipped humanoid.
   EXPECT_EQ(t->obsDim(), 1 + 3 + 3 + 1 + 3 + 9 + 2 * 27);

@@ -84,13 +84,16 @@ std::string specText() { return readTextFile(kData + "/twin_arm_spec.yaml"); }
 
 // A test fixture, not in tasks/tasks.cpp's list: added once, before the first factory.
 void registerTwinArm() {
-  static const bool registered = registerTask({"twin_arm_test", "tests/data/twin_arm.xml", &makeTwinArm});
+  static const bool registered = [] {
+    taskCatalog().add({"twin_arm_test", "tests/data/twin_arm.xml", &makeTwinArm});
+    return true;
+  }();
   (void)registered;
 }
 
 TaskFactory factory(const std::string& env_yaml = "{}", const sym::SymmetrySpec& spec = twinSpec()) {
   registerTwinArm();
-  return TaskFactory("twin_arm_test", spec, YAML::Load(env_yaml), {}, "test env");
+  return TaskFactory(taskCatalog(), "twin_arm_test", spec, YAML::Load(env_yaml), {}, "test env");
 }
 
 TEST(TaskFramework, ResetsAndRuns1000RandomStepsWithFiniteObservationsAndRewards) {
@@ -210,7 +213,7 @@ TEST(SymmetryVerifier, NamesTheJointsWhenActuatorsAreSwappedInsideALimb) {
 TEST(TaskErrors, UnknownTaskListsTheKnownOnes) {
   registerTwinArm();
   try {
-    TaskFactory("no_such_task", twinSpec(), YAML::Load("{}"));
+    TaskFactory(taskCatalog(), "no_such_task", twinSpec(), YAML::Load("{}"));
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("twin_arm_test"), std::string::npos) << e.what();

@@ -46,7 +46,7 @@ Trace drive(Task& t, Rng& rng, Rng& reset_rng, int steps) {
   return trace;
 }
 
-// Where saveState puts the count of the task's extras (the layout of common/task/task_state.cpp).
+// Where saveState puts the count of the task's extras (the layout of common/sim/task_state.cpp).
 std::size_t extrasCountIndex(const Task& t) {
   const mjModel* m = t.model();
   const std::size_t nterms = t.rewardTermNames().size();

@@ -1,4 +1,4 @@
-// The task written in YAML (common/task/yaml_task.cpp, docs/yaml_task.md) on robots without task
+// The task written in YAML (common/sim/yaml/yaml_task.cpp, docs/yaml_task.md) on robots without task
 // code: the C4 walker's locomotion task (configs/tasks/c4_walker.yaml) and the mirror-symmetric twin
 // arm of tests/data. The physics verifier proves their observations and rewards symmetric; the
 // terms measure what they say; sensors are read for the state a step ends in; and every mistake a
@@ -25,7 +25,7 @@ constexpr const char* kWalker = "c4_walker";
 // The message of what building the task throws ("" when nothing is thrown).
 std::string buildError(const YAML::Node& env, const sym::SymmetrySpec& spec) {
   try {
-    TaskFactory f(kWalker, spec, env);
+    TaskFactory f(task::taskCatalog(), kWalker, spec, env);
   } catch (const std::exception& e) {
     return e.what();
   }
@@ -253,7 +253,7 @@ reset: {joint_noise: 0.3, velocity_noise: 0.3}
 
 TEST(YamlTask, MirrorRobotWithACentralJointAndACarriedBallIsProvenSymmetric) {
   const sym::SymmetrySpec spec = sym::SymmetrySpec::load(kData + "/twin_arm_spec.yaml");
-  const TaskFactory f("twin_arm_yaml", spec, YAML::Load(kTwinArmEnv));
+  const TaskFactory f(task::taskCatalog(), "twin_arm_yaml", spec, YAML::Load(kTwinArmEnv));
   SymmetryVerifierOptions opt;
   opt.num_states = 6;
   opt.diagnosis_states = 2;
@@ -268,7 +268,7 @@ TEST(YamlTask, MirrorRobotWithACentralJointAndACarriedBallIsProvenSymmetric) {
   out << root;
   const auto polar = sym::SymmetrySpec::parseString(out.c_str(), "polar_ball.yaml");
   try {
-    TaskFactory bad("twin_arm_yaml", polar, YAML::Load(kTwinArmEnv));
+    TaskFactory bad(task::taskCatalog(), "twin_arm_yaml", polar, YAML::Load(kTwinArmEnv));
     ADD_FAILURE() << "a polar angular velocity was accepted";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("a world angular velocity ('ball_ang_vel') transforms under the mirror with "
