@@ -37,7 +37,7 @@ MASA_LCM_URL="udpm://239.255.76.67:7695?ttl=0&recv_buf_size=$(cat /proc/sys/net/
   bash deploy/train.sh --recipe "$recipe" --actors "$actors" --updates "$updates" --run-dir "$run_dir/run" \
   "${sets[@]}" --set runner.eval_every=0 > "$run_dir/train.log" 2>&1
 fps=$(awk -F, -v w="$warmup" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "fps") c = i; next }
-      $1 >= w { print $c }' "$run_dir/run/metrics.csv" | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
+      $1 > w { print $c }' "$run_dir/run/metrics.csv" | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
 [ -n "$fps" ] || { echo "e2e_efficiency.sh: no fps after the warm-up; see $run_dir/train.log" >&2; exit 1; }
 echo "train.sh: $actors actors, median fps $fps over updates $warmup..$((updates - 1)) (run dir $run_dir/run)"
 awk -v f="$fps" -v b="$bound" 'BEGIN { printf "efficiency %.2f\n", f / b }'

@@ -28,7 +28,7 @@ MASA_LCM_URL="udpm://239.255.76.67:$((7600 + RANDOM % 50 * 8))?ttl=0&recv_buf_si
   --updates "$updates" --run-dir "$out/run" --set ppo.horizon=24 --set ppo.minibatch_size=$((samples / 4)) \
   --set runner.eval_every=0 --set runner.plot_every=0 > "$out/train.log" 2>&1 ||
   { echo "e2e_ranks: $task ranks $ranks actors $actors FAILED (see $out/train.log)"; exit 1; }
-fps=$(awk -F, -v w="$warmup" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "fps") c = i; next } $1 >= w { print $c }' \
+fps=$(awk -F, -v w="$warmup" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "fps") c = i; next } $1 > w { print $c }' \
   "$out/run/metrics.csv" | sort -g | awk '{ v[NR] = $1 } END { print NR ? (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) : "nan" }')
 printf 'e2e_ranks: %s ranks %d actors %d x %d envs, threads %d: fps median %.0f (updates %d-%d)\n' \
   "$task" "$ranks" "$actors" "$envs" "$threads" "$fps" "$warmup" "$updates"

@@ -121,8 +121,8 @@ median() { sort -g | awk '{ v[NR] = $1 } END { if (NR == 0) print "nan"; else if
 pctl() { sort -g | awk -v p="$1" '{ v[NR] = $1 } END { if (NR == 0) { print "nan"; exit } r = int(p / 100 * NR); if (r < p / 100 * NR) r++; if (r < 1) r = 1; print v[r] }'; }
 
 col() { head -1 "$metrics" | tr ',' '\n' | grep -nx "$1" | cut -d: -f1; }
-fps_col=$(col fps) epoch_col=$(col epoch) drop_col=$(col dropped_chunks)
-steady() { awk -F, -v c="$1" -v e="$epoch_col" -v w="$warmup" 'NR > 1 && $e >= w { print $c }' "$metrics"; }
+fps_col=$(col fps) update_col=$(col update) drop_col=$(col dropped_chunks)
+steady() { awk -F, -v c="$1" -v u="$update_col" -v w="$warmup" 'NR > 1 && $u > w { print $c }' "$metrics"; }
 fps_median=$(steady "$fps_col" | median)
 fps_min=$(steady "$fps_col" | sort -g | head -1)
 fps_max=$(steady "$fps_col" | sort -g | tail -1)

@@ -5,7 +5,7 @@
 # included; the learner checkpoints, so the run directory is resumable.
 #   deploy/train.sh [task] [method] [--actors K] [--envs E] [--updates N] [--set key=value ...]
 #   deploy/train.sh --recipe NAME [--actors K] [--run-dir DIR] ...   (configs/recipes/NAME.yaml: its task,
-#                   method, batch and ppo.max_epochs updates; its environments split over the actors)
+#                   method, batch and ppo.max_updates updates; its environments split over the actors)
 #   deploy/train.sh [task] [method] --hosts FILE [--envs E] [--updates N] [--set key=value ...]
 #   deploy/train.sh --resume RUN_DIR [--actors K] [--envs E] [--updates N]   (N counts all updates)
 # FILE has one host per line, "host [actors] [envs]" (default 1 actor of E environments), '#'
@@ -58,7 +58,7 @@ if [ -n "$recipe" ]; then
   [ "$task_given" = 1 ] || task=$(sed -n 's/^task: //p' <<< "$resolved")
   [ "$method_given" = 1 ] || method=$(sed -n 's/^method: //p' <<< "$resolved")
   recipe_envs=$(sed -n 's/^  num_envs: //p' <<< "$resolved")
-  [ -n "$updates" ] || updates=$(sed -n 's/^  max_epochs: //p' <<< "$resolved")
+  [ -n "$updates" ] || updates=$(sed -n 's/^  max_updates: //p' <<< "$resolved")
   if [ "$envs_given" = 0 ] && [ -z "$hosts_file" ]; then
     if (( recipe_envs % actors != 0 )); then
       echo "train.sh: recipe $recipe has $recipe_envs environments, not divisible over $actors actors (give --envs)" >&2

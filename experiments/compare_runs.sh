@@ -79,9 +79,11 @@ for i in "${!labels[@]}"; do
   dir="$out/${tasks[$i]}/${labels[$i]}_s${seeds[$i]}"
   mkdir -p "$dir"
   cp "${runs[$i]}/config.yaml" "$dir/"
-  # metrics.csv: the header and the updates 0..N-1 (column 1 is the update; a resumed run's rows
-  # were cut back to its checkpoint, so each update appears once).
-  awk -F, -v n="$updates" 'NR == 1 || ($1 ~ /^[0-9]+$/ && $1 < n)' "${runs[$i]}/metrics.csv" > "$dir/metrics.csv"
+  # metrics.csv: the header and the updates 1..N (column 1 is the update; a resumed run's rows
+  # were cut back to its checkpoint, so each update appears once). Runs made before issue #32
+  # count epochs from 0 there (epoch,version,...).
+  awk -F, -v n="$updates" 'NR == 1 { old = ($1 == "epoch") } NR == 1 || ($1 ~ /^[0-9]+$/ && (old ? $1 < n : $1 <= n))' \
+    "${runs[$i]}/metrics.csv" > "$dir/metrics.csv"
   used=$(( $(wc -l < "$dir/metrics.csv") - 1 ))
   if [ "$used" -ge "$updates" ]; then touch "$dir/done"; else short+=("${labels[$i]}_s${seeds[$i]} (${used} updates)"); fi
   echo "${labels[$i]} ${seeds[$i]} ${tasks[$i]} $used ${runs[$i]}" >> "$out/sources.txt"

@@ -61,7 +61,7 @@ for m in $methods; do
     echo "film_grid.sh: $m seed $seed has no policy or checkpoint yet: left out"
     continue
   fi
-  updates=$(tail -n 1 "$run/metrics.csv" 2> /dev/null | cut -d, -f2)
+  updates=$(tail -n 1 "$run/metrics.csv" 2> /dev/null | cut -d, -f1)
   label="$m seed $seed (${updates:-?} updates)"
   xvfb-run -a "$eval_bin" "$target" --episodes 1 --seed "$episode_seed" --per-episode --video "$work/$m.png" \
     --label "$label" --strip-frames "$frames" --width "$width" --height "$height" > "$work/$m.log" 2>&1 || {

@@ -73,7 +73,7 @@ if [ -n "$extend" ]; then
     echo "grid.sh: --extend changes only the updates of the grid in --out: give it no other grid options" >&2; exit 2
   fi
   have=$(sed -n 's/^updates=//p' "$out/grid.txt")
-  [ -n "$have" ] || { echo "grid.sh: $out's runs follow each recipe's ppo.max_epochs (no --updates); --extend needs a number to go on from" >&2; exit 2; }
+  [ -n "$have" ] || { echo "grid.sh: $out's runs follow each recipe's ppo.max_updates (no --updates); --extend needs a number to go on from" >&2; exit 2; }
   [ "$extend" -gt "$have" ] || { echo "grid.sh: $out's runs already go to $have updates; --extend $extend must be more" >&2; exit 2; }
   # A finished run goes on only from its checkpoint; without one (a record made without them) it
   # would start afresh and lose its updates, so the extension is refused before anything changes.
@@ -144,12 +144,13 @@ if [ "$status" = 1 ]; then
   running=0
   ( flock -n 9 ) 9> "$out/.grid.lock" || running=1
   slots_now=$( [ "$running" = 1 ] && [ -f "$out/.slots" ] && wc -l < "$out/.slots" || nproc)
-  echo "grid $out: $tasks / $methods / seeds $seeds, ${updates:-the recipe max_epochs} updates a run;" \
+  echo "grid $out: $tasks / $methods / seeds $seeds, ${updates:-the recipe max_updates} updates a run;" \
        "$( [ "$running" = 1 ] && echo "running, $slots_now at a time" || echo "not running")"
   for t in $tasks; do for m in $methods; do for sd in $seeds; do
     dir="$out/$t/${m}_s$sd" target=$updates
-    [ -n "$target" ] || target=$(sed -n 's/^ *max_epochs: *\([0-9]*\).*/\1/p' "$dir/config.yaml" 2>/dev/null | head -1)
-    [ -n "$target" ] || target=$(sed -n 's/^ *max_epochs: *\([0-9]*\).*/\1/p' "configs/recipes/$t.yaml" 2>/dev/null | head -1)
+    # max_epochs: the key's name in run directories made before issue #32
+    [ -n "$target" ] || target=$(sed -n 's/^ *max_\(updates\|epochs\): *\([0-9]*\).*/\2/p' "$dir/config.yaml" 2>/dev/null | head -1)
+    [ -n "$target" ] || target=$(sed -n 's/^ *max_updates: *\([0-9]*\).*/\1/p' "configs/recipes/$t.yaml" 2>/dev/null | head -1)
     state=waiting
     if [ -f "$dir/done" ]; then state=done
     elif [ -f "$dir/metrics.csv" ]; then
@@ -161,11 +162,11 @@ if [ "$status" = 1 ]; then
     { run[NR] = $0; t[NR] = $1; m[NR] = $2; s[NR] = $3; target[NR] = $4; state[NR] = $5; rows = 0; spu = ""
       if ($5 != "waiting") {
         n = 0
-        ev = ""; col = 0  # the last evaluation of the policy mean, from the eval_return column
+        ev = ""; col = 0; wc = 0  # the last evaluation of the policy mean (eval_return); the wall clock (wall_time_s)
         while ((getline line < $6) > 0) {
           nf = split(line, f, ",")
-          if (n == 0) { for (c = 1; c <= nf; c++) if (f[c] == "eval_return") col = c }
-          else { w[n] = f[4]; if (col > 0 && f[col] != "" && f[col] != "nan") ev = f[col] }
+          if (n == 0) { for (c = 1; c <= nf; c++) { if (f[c] == "eval_return") col = c; if (f[c] == "wall_time_s") wc = c } }
+          else { w[n] = f[wc]; if (col > 0 && f[col] != "" && f[col] != "nan") ev = f[col] }
           n++
         }
         close($6); rows = n - 1

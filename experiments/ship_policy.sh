@@ -38,8 +38,8 @@ cp "$run/config.yaml" "$run/metrics.csv" "$out/"
 "$build/tools/masa_eval" "$out/policy.bin" --episodes "$episodes" --threads "$(nproc)" --csv "$out/eval.csv" \
   | grep -v '^wrote' > "$out/eval.txt"
 xvfb-run -a "$build/tools/masa_eval" "$out/policy.bin" --episodes 1 --video "$out/strip.png" --width 400 --height 300 > /dev/null
-updates=$(tail -n 1 "$run/metrics.csv" | cut -d, -f1) steps=$(tail -n 1 "$run/metrics.csv" | cut -d, -f3)
-wall=$(tail -n 1 "$run/metrics.csv" | cut -d, -f4)
+updates=$(tail -n 1 "$run/metrics.csv" | cut -d, -f1) steps=$(tail -n 1 "$run/metrics.csv" | cut -d, -f2)
+wall=$(tail -n 1 "$run/metrics.csv" | cut -d, -f3)
 # policy/README.md: what was shipped, how it was made, and how it does.
 {
   echo "# $task: shipped policy"

@@ -256,9 +256,8 @@ void Learner::update() {
     for (int64_t rank_steps : ranks_->gather(buffer_->size())) steps += rank_steps;
   }
   env_steps_ += steps;
-  report_.epoch = updates_;
   ++updates_;
-  report_.version = updates_;
+  report_.update = updates_;
   report_.env_steps = env_steps_;
   report_.wall_time_s = wallTime();
   report_.fps = dt > 0 ? steps / dt : 0.0;

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
   url = masa::transport::loopbackUrl();
   app.add_option("--url", url, "LCM provider URL")->capture_default_str();
   app.add_option("--run-id", run_id, "run id actors must carry (default: random, or the checkpoint's)");
-  app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_epochs)");
+  app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_updates)");
   std::string key_file;
   bool no_auth = false;
   auto* key_opt = app.add_option("--key-file", key_file,
@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
                                      : "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" +
                                            std::to_string(rc.seed) + "_" + timestamp();
     }
-    if (max_updates < 0) max_updates = rc.ppo.max_epochs;
+    if (max_updates < 0) max_updates = rc.ppo.max_updates;
     if (ranks) {
       // Rank 0's run directory (its default has rank 0's timestamp) for every rank.
       std::vector<uint8_t> dir(opt.run_dir.begin(), opt.run_dir.end());

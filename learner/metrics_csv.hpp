@@ -9,9 +9,11 @@
 
 namespace masa::learner {
 
-// Keeps the header line and the rows whose update number (the first column, `epoch`) is below
-// `updates`, the checkpoint's update count, with as many columns as the header; drops the rest
-// (a row torn by the kill among them).
+// Keeps the header line and the rows whose update number (the first column, `update`, from 1) is
+// at most `updates`, the checkpoint's update count, with as many columns as the header; drops the
+// rest (a row torn by the kill among them). A file of a run made before updates had one name
+// (columns `epoch,version,...`, epoch from 0 and version = epoch + 1) is rewritten in today's form
+// first: its `epoch` column goes and `version` is the update, so the resumed run's rows match.
 // Rewrites the file atomically (a temporary beside it, renamed). A missing file stays missing.
 // Returns the number of lines removed. Throws std::runtime_error when the file cannot be rewritten.
 int64_t truncateMetricsCsv(const std::string& path, int64_t updates);

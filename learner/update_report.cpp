@@ -45,8 +45,7 @@ masa::lcmt_learner_stats statsMessage(const UpdateReport& report, const ReportCo
   masa::lcmt_learner_stats s;
   s.run_id = run_id;
   s.utime = transport::wallClockMicros();
-  s.epoch = report.epoch;
-  s.version = report.version;
+  s.update = report.update;
   s.env_steps = report.env_steps;
   s.fps = static_cast<float>(report.fps);
   s.mean_episode_return = static_cast<float>(report.mean_return);
@@ -85,7 +84,7 @@ void appendMetricsRow(const std::string& path, const UpdateReport& report, const
   const bool fresh = !fs::exists(path) || fs::file_size(path) == 0;
   std::ofstream f(path, std::ios::app);
   if (fresh) {
-    f << "epoch,version,env_steps,wall_time_s,fps,return,length,success";
+    f << "update,env_steps,wall_time_s,fps,return,length,success";
     for (const auto& t : columns.term_names) f << ",term_" << t;
     f << ",actor_loss,critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped_chunks,dropped_envs";
     f << ",eval_return,eval_length,eval_success";
@@ -94,7 +93,7 @@ void appendMetricsRow(const std::string& path, const UpdateReport& report, const
   }
   const ppo::PpoStats& p = report.ppo;
   f.precision(9);
-  f << report.epoch << ',' << report.version << ',' << report.env_steps << ',' << report.wall_time_s << ','
+  f << report.update << ',' << report.env_steps << ',' << report.wall_time_s << ','
     << report.fps << ',' << report.mean_return << ',' << report.mean_length << ',' << report.success_rate;
   for (double t : report.term_means) f << ',' << t;
   f << ',' << p.actor_loss << ',' << p.critic_loss << ',' << p.entropy << ',' << p.bounds_loss << ','
@@ -107,7 +106,7 @@ void appendMetricsRow(const std::string& path, const UpdateReport& report, const
 
 void printProgress(const UpdateReport& report, const ReportColumns& columns, int64_t max_updates,
                    double update_interval_s, int eval_episodes) {
-  const int64_t done = report.version;  // updates done, this one included
+  const int64_t done = report.update;  // updates done, this one included
   char eta[32] = "";
   if (max_updates > done) {
     const long remaining = std::lround(update_interval_s * static_cast<double>(max_updates - done));

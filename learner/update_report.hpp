@@ -1,10 +1,10 @@
 // What one update did, and the three places it is told: the lcmt_learner_stats message (lcm-spy,
 // dashboards), a row of metrics.csv, and the progress line on stdout.
 //
-// Counting: one update is one PPO "epoch" in rl_games' sense (one batch collected, then
-// ppo.mini_epochs passes over it in minibatches); ppo.max_epochs is the number of updates. The
-// learner counts updates and nothing else: the policy version it broadcasts is the number of
-// updates its parameters have seen.
+// Counting: one word, "update": one batch collected, then ppo.mini_epochs passes over it in
+// minibatches (rl_games calls it an epoch); ppo.max_updates is how many a run makes. Updates are
+// numbered from 1, and a policy is named by the update that made it: the policy version the
+// learner broadcasts is the number of updates its parameters have seen (0: the initial policy).
 #pragma once
 
 #include <cmath>
@@ -21,8 +21,7 @@
 namespace masa::learner {
 
 struct UpdateReport {
-  int64_t epoch = 0;    // this update's index, from 0 (metrics.csv's first column)
-  int64_t version = 0;  // the policy version it produced: epoch + 1
+  int64_t update = 0;  // this update's number, from 1: the policy version it produced (metrics.csv's first column)
   int64_t env_steps = 0;
   double wall_time_s = 0, fps = 0;
   int num_episodes = 0;

@@ -39,7 +39,7 @@ struct Run {
   int seed = 0;
   bool done = false;
   std::map<std::string, std::vector<double>> columns;
-  size_t rows() const { return columns.count("epoch") ? columns.at("epoch").size() : 0; }
+  size_t rows() const { return columns.count("update") ? columns.at("update").size() : 0; }
   const std::vector<double>& col(const std::string& name) const {
     static const std::vector<double> empty;
     auto it = columns.find(name);
@@ -60,7 +60,15 @@ Run readRun(const fs::path& csv) {
   }
   Run run;
   for (const auto& n : names) run.columns[n];
-  for (const char* need : {"epoch", "env_steps", "wall_time_s", "return"})
+  // A run recorded before the update had one name counts epochs from 0 beside version = epoch + 1:
+  // its `version` column is the update.
+  const bool old_form = names.size() >= 2 && names[0] == "epoch" && names[1] == "version";
+  if (old_form) {
+    names[1] = "update";
+    run.columns.erase("version");
+    run.columns["update"];
+  }
+  for (const char* need : {"update", "env_steps", "wall_time_s", "return"})
     if (!run.columns.count(need)) throw std::runtime_error(csv.string() + ": no column '" + need + "'");
   int line_no = 1;
   while (std::getline(in, line)) {

@@ -62,7 +62,7 @@ std::optional<Stamp> readStamp(const std::string& channel, const void* data, int
   if (channel == transport::kPolicyChannel) {
     if (auto m = decodeAs<masa::lcmt_policy_params>(data, size)) return Stamp{m->run_id, m->utime, m->version};
   } else if (channel == transport::kLearnerStatsChannel) {
-    if (auto m = decodeAs<masa::lcmt_learner_stats>(data, size)) return Stamp{m->run_id, m->utime, m->version};
+    if (auto m = decodeAs<masa::lcmt_learner_stats>(data, size)) return Stamp{m->run_id, m->utime, m->update};
   } else if (channel == transport::kHeartbeatChannel) {
     if (auto m = decodeAs<masa::lcmt_actor_heartbeat>(data, size)) return Stamp{m->run_id, m->utime, m->actor_id};
   }

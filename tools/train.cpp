@@ -6,7 +6,7 @@
 // debugging, learning checks and small experiments. The run directory is the learner's (config,
 // metrics, checkpoint, learning curve).
 //   masa_train --set task=a1_beam --set method=sa --updates 50 --run-dir runs/a1_sa
-//   masa_train --recipe a1_beam --threads 2     (configs/recipes/a1_beam.yaml, its ppo.max_epochs updates)
+//   masa_train --recipe a1_beam --threads 2     (configs/recipes/a1_beam.yaml, its ppo.max_updates updates)
 //   masa_train --resume runs/x --updates 1200   (go on to 1200 updates in total, from its checkpoint)
 #include <CLI/CLI.hpp>
 #include <atomic>
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   app.add_option("--configs", configs, "configs directory")->capture_default_str();
   app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_inprocess)");
   app.add_option("--recipe", recipe, "a recipe of configs/recipes/ (or a YAML file), applied before --set");
-  app.add_option("--updates", updates, "PPO updates to make in total (default: ppo.max_epochs)")
+  app.add_option("--updates", updates, "PPO updates to make in total (default: ppo.max_updates)")
       ->check(CLI::PositiveNumber);
   app.add_option("--threads", threads, "OpenMP threads over the environments")->capture_default_str()
       ->check(CLI::Range(1, 1024));
@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
       run_dir = resume;
     }
     const auto rc = masa::config::loadRunConfig(configs, overrides, resume.empty() ? "" : resume + "/config.yaml");
-    if (updates == 0) updates = rc.ppo.max_epochs;
+    if (updates == 0) updates = rc.ppo.max_updates;
     if (run_dir.empty())
       run_dir = "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" + std::to_string(rc.seed) +
                 "_inprocess";

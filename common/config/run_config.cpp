@@ -50,12 +50,18 @@ void mergeOpen(YAML::Node dst, const YAML::Node& src, const std::string& path, c
   }
 }
 
+// Keys renamed since runs were first recorded, read under their new name so that old run
+// directories, policy files and configs still load: (old full path, new key in the same section).
+// ppo.max_epochs became ppo.max_updates when the update got one name (issue #32).
+const std::map<std::string, std::string> kRenamedKeys = {{"ppo.max_epochs", "max_updates"}};
+
 // Overlays `src` onto `dst` (a clone of the schema tree), checking every key against `schema`.
 void overlay(YAML::Node dst, const YAML::Node& src, const YAML::Node& schema, const std::string& path,
              const std::string& file, std::map<std::string, std::string>& origin) {
   if (!src.IsMap()) throw ConfigError(file, path.empty() ? "(root)" : path, "expected a map, got " + kindName(src));
   for (const auto& kv : src) {
-    const std::string key = kv.first.as<std::string>();
+    std::string key = kv.first.as<std::string>();
+    if (const auto renamed = kRenamedKeys.find(join(path, key)); renamed != kRenamedKeys.end()) key = renamed->second;
     const std::string full = join(path, key);
     const YAML::Node value = kv.second;
     if (isOpenSection(full)) {
@@ -314,7 +320,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   p.normalize_value = r.get<bool>("ppo.normalize_value", "true or false");
   p.normalize_advantage = r.get<bool>("ppo.normalize_advantage", "true or false");
   p.value_bootstrap = r.get<bool>("ppo.value_bootstrap", "true or false");
-  p.max_epochs = r.atLeast("ppo.max_epochs", 1);
+  p.max_updates = r.atLeast("ppo.max_updates", 1);
   p.max_policy_lag = r.atLeast("ppo.max_policy_lag", 0);
 
   RunnerConfig& u = rc.runner;

@@ -36,7 +36,7 @@ struct PpoConfig {
   bool normalize_value = true;
   bool normalize_advantage = true;
   bool value_bootstrap = true;
-  int max_epochs = 10000;
+  int max_updates = 10000;
   int max_policy_lag = 0;
 };
 

@@ -63,8 +63,7 @@ struct WireLayoutOf<masa::lcmt_learner_stats> {
   static constexpr WireField fields[] = {
       {"run_id", WireType::kInt64},
       {"utime", WireType::kInt64},
-      {"epoch", WireType::kInt64},
-      {"version", WireType::kInt64},
+      {"update", WireType::kInt64},
       {"env_steps", WireType::kInt64},
       {"fps", WireType::kFloat},
       {"mean_episode_return", WireType::kFloat},

@@ -41,7 +41,7 @@ for _ in $(seq 1 600); do finished "$id" && break; sleep 0.2; done
 finished "$id" || { scancel "$id"; fail "job $id still runs after 120 s"; }
 rows=$(($(wc -l < "$work/run/metrics.csv" 2> /dev/null || echo 1) - 1))
 [ "$rows" -eq 20 ] || fail "metrics.csv has $rows rows, expected 20"
-[ "$(tail -n 1 "$work/run/metrics.csv" | cut -d, -f3)" -eq $((20 * 16 * 16)) ] || fail "env steps are not both ranks'"
+[ "$(tail -n 1 "$work/run/metrics.csv" | cut -d, -f2)" -eq $((20 * 16 * 16)) ] || fail "env steps are not both ranks'"
 grep -q "rank 1 of 2: stopped after 20 updates" "$work/run.out" || fail "rank 1 did not stop cleanly"
 [ "$(grep -c 'masa_actor [01]: stopped after' "$work/run.out")" -eq 2 ] || fail "the actors did not stop cleanly"
 log "   20 updates, both ranks and both actors stopped"

@@ -74,8 +74,8 @@ version=$("$build/tools/masa_train" --version) || fail "masa_train --version fai
 [ "$(grep -c "^# binaries: masa $version\$" grid/a1_beam/masa_s0.log)" -eq 2 ] || fail "masa's log does not name the binaries twice"
 grep -qx "# Written by masa $version" grid/a1_beam/sa_s0/config.yaml || fail "config.yaml does not name the commit"
 [ "$(($(wc -l < "$csv") - 1))" -eq 150 ] || fail "masa's metrics.csv has $(($(wc -l < "$csv") - 1)) rows, not 150"
-# One row per update, no update twice: the epochs are 0..149 in order.
-awk -F, 'NR > 1 && $1 != NR - 2 { bad = 1 } END { exit bad }' "$csv" || fail "masa's epochs are not 0..149 in order"
+# One row per update, no update twice: the updates are 1..150 in order.
+awk -F, 'NR > 1 && $1 != NR - 1 { bad = 1 } END { exit bad }' "$csv" || fail "masa's updates are not 1..150 in order"
 for f in grid/verdict.md grid/a1_beam/runs.csv grid/a1_beam/curves/return_masa.dat grid/a1_beam/curves/eval_return_sa.dat; do
   [ -s "$f" ] || fail "no $f"
 done
@@ -108,8 +108,8 @@ grep -q "^updates=160$" grid/grid.txt && grep -q "^# extended from 150 to 160 up
 for m in masa sa; do
   [ -f "grid/a1_beam/${m}_s0/done" ] || fail "the extended $m run is not marked done"
   grep -q -- "--updates 160 --resume .*${m}_s0" "grid/a1_beam/${m}_s0.log" || fail "$m was not resumed to 160 updates"
-  awk -F, 'NR > 1 && $1 != NR - 2 { bad = 1 } END { exit bad || NR != 161 }' "grid/a1_beam/${m}_s0/metrics.csv" || \
-    fail "$m's epochs are not 0..159 in order"
+  awk -F, 'NR > 1 && $1 != NR - 1 { bad = 1 } END { exit bad || NR != 161 }' "grid/a1_beam/${m}_s0/metrics.csv" || \
+    fail "$m's updates are not 1..160 in order"
 done
 [ -s grid/verdict.md ] || fail "the extended grid did not redo the comparison"
 
@@ -137,14 +137,14 @@ grep -q "^| masa | 2 |" grown/verdict.md || fail "the grown grid's comparison is
 # with --replot and kept in grid.txt (a later --replot still has it); a column the runs lack, or a
 # malformed one, is refused and changes nothing. The same seeds in another order are the grid as
 # it is, not a growth.
-"$src/experiments/grid.sh" --replot --out grown --milestone a1_beam:epoch=10 --milestone epoch=100000 > ms.out 2>&1 || \
+"$src/experiments/grid.sh" --replot --out grown --milestone a1_beam:update=11 --milestone update=100000 > ms.out 2>&1 || \
   fail "--replot with milestones failed: $(cat ms.out)"
-grep -qx "milestone=a1_beam:epoch=10" grown/grid.txt && grep -qx "milestone=epoch=100000" grown/grid.txt || \
+grep -qx "milestone=a1_beam:update=11" grown/grid.txt && grep -qx "milestone=update=100000" grown/grid.txt || \
   fail "grid.txt does not keep the milestones: $(cat grown/grid.txt)"
 "$src/experiments/grid.sh" --replot --out grown > ms2.out 2>&1 || fail "--replot after milestones failed"
-at10=$(awk -F, 'NR > 1 && $1 == 10 { print $3 }' grown/a1_beam/masa_s1/metrics.csv)
-[ "$at10" = 704 ] || fail "epoch 10 is at $at10 env steps, not 8 envs x 8 steps x 11 = 704"
-grep -q "^Milestone epoch >= 10:" grown/verdict.md || fail "no milestone in the verdict: $(cat grown/verdict.md)"
+at11=$(awk -F, 'NR > 1 && $1 == 11 { print $2 }' grown/a1_beam/masa_s1/metrics.csv)
+[ "$at11" = 704 ] || fail "update 11 is at $at11 env steps, not 8 envs x 8 steps x 11 = 704"
+grep -q "^Milestone update >= 11:" grown/verdict.md || fail "no milestone in the verdict: $(cat grown/verdict.md)"
 grep -qx "| masa | 2 of 2 | s0 704, s1 704 | 704 |  |" grown/verdict.md || fail "masa's milestone row: $(cat grown/verdict.md)"
 grep -qx "| sa | 2 of 2 | s0 704, s1 704 | 704 | 0 \[0, 0\] |" grown/verdict.md || fail "sa's milestone row: $(cat grown/verdict.md)"
 grep -qx "| sa | 0 of 2 | s0 -, s1 - | not within the budget | n/a (a seed never reached it) |" grown/verdict.md || \
@@ -152,7 +152,7 @@ grep -qx "| sa | 0 of 2 | s0 -, s1 - | not within the budget | n/a (a seed never
 cp grown/grid.txt grid_before_ms.txt
 "$src/experiments/grid.sh" --replot --out grown --milestone no_such_column=1 > ms3.out 2>&1 && fail "a milestone on a missing column was accepted"
 grep -q "have no column 'no_such_column'" ms3.out || fail "no reason given: $(cat ms3.out)"
-"$src/experiments/grid.sh" --replot --out grown --milestone epoch > ms4.out 2>&1 && fail "a malformed milestone was accepted"
+"$src/experiments/grid.sh" --replot --out grown --milestone update > ms4.out 2>&1 && fail "a malformed milestone was accepted"
 grep -q "write \[TASK:\]COLUMN=LEVEL" ms4.out || fail "no reason given: $(cat ms4.out)"
 "$src/experiments/grid.sh" --replot --out grown --seeds "1 0" > ms5.out 2>&1 || fail "the grid's seeds in another order were refused: $(cat ms5.out)"
 cmp -s grid_before_ms.txt grown/grid.txt || fail "a refused milestone or a reordering changed grid.txt: $(diff grid_before_ms.txt grown/grid.txt)"
@@ -226,7 +226,7 @@ grep -q "is not a grid" film4.out || fail "no reason given: $(cat film4.out)"
 # 3e. compare_runs.sh: any runs under labels of one's own (variants, runs of several grids), cut at
 # a common budget, through masa_compare; refusals change nothing.
 "$src/experiments/compare_runs.sh" --out cmp --updates 100 --reference b a=grid/a1_beam/sa_s0 b=grid/a1_beam/masa_s0 \
-  --milestone epoch=10 > cmp.out 2>&1 || fail "compare_runs.sh failed: $(cat cmp.out)"
+  --milestone update=11 > cmp.out 2>&1 || fail "compare_runs.sh failed: $(cat cmp.out)"
 grep -qx "| b | 1 of 1 | s0 704 | 704 |  |" cmp/verdict.md || fail "compare_runs.sh's milestone: $(cat cmp/verdict.md)"
 for l in a b; do
   [ "$(wc -l < cmp/a1_beam/${l}_s0/metrics.csv)" = 101 ] && [ -f cmp/a1_beam/${l}_s0/done ] || \

@@ -105,8 +105,8 @@ EOF
     MASA_RUNS_DIR="$work/runs" timeout 600 "${launcher[@]}" --updates "$measure" > "$work/launcher.log" 2>&1 ||
       fail "the launcher did not finish $measure updates with $drop% loss (status $?)"
     csv="$(run_dir_of "$work/runs")metrics.csv"
-    # Steady state: from the end of update 5 to the last (wall_time_s is column 4).
-    upm=$(awk -F, -v n="$measure" 'NR == 6 { t0 = $4 } NR == n + 1 { t1 = $4 } END { printf "%.1f", (n - 5) * 60 / (t1 - t0) }' "$csv")
+    # Steady state: from the end of update 5 to the last (wall_time_s is column 3).
+    upm=$(awk -F, -v n="$measure" 'NR == 6 { t0 = $3 } NR == n + 1 { t1 = $3 } END { printf "%.1f", (n - 5) * 60 / (t1 - t0) }' "$csv")
     drops=$(grep "^masa_learner: rollout chunks accepted" "$work/launcher.log" | tail -1 | sed 's/^masa_learner: //')
     short=$(sed -n 's/^masa_learner: updates on batches short of lost environments \([0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
     [ -n "$short" ] && drops="$drops, short batches $short"

@@ -40,7 +40,7 @@ log "1. 2 learner ranks + 2 actors, 6 updates"
 job 6 --run-dir "$work/run" > "$work/job1.log" 2>&1 || fail "the job failed or hung (exit $?)"
 rows=$(($(wc -l < "$work/run/metrics.csv") - 1))
 [ "$rows" -eq 6 ] || fail "metrics.csv has $rows rows, expected 6"
-steps=$(tail -n 1 "$work/run/metrics.csv" | cut -d, -f3)
+steps=$(tail -n 1 "$work/run/metrics.csv" | cut -d, -f2)
 [ "$steps" -eq $((6 * 16 * 16)) ] || fail "env steps $steps, expected $((6 * 16 * 16)) (both ranks' batches)"
 grep -q "rank 1 of 2: run id" "$work/job1.log" || fail "no rank 1"
 [ "$(grep -c 'rollouts to learner rank' "$work/job1.log")" -eq 2 ] || fail "the actors did not report their ranks"

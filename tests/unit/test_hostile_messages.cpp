@@ -47,8 +47,7 @@ masa::lcmt_learner_stats sampleStats() {
   masa::lcmt_learner_stats s{};
   s.run_id = 42;
   s.utime = 1'700'000'000'000'000;
-  s.epoch = 16;
-  s.version = 17;
+  s.update = 17;
   s.env_steps = 1 << 20;
   s.fps = 5000.0f;
   s.num_episodes = 3;

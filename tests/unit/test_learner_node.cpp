@@ -143,8 +143,7 @@ TEST(LearnerNode, OneBatchFromAFakeActorMakesVersionOneAndPublishesParamsStatsAn
   for (float s : params.obs_std) EXPECT_GT(s, 0.0f);
 
   ASSERT_EQ(num_stats, 1);
-  EXPECT_EQ(stats.version, 1);
-  EXPECT_EQ(stats.epoch, 0);
+  EXPECT_EQ(stats.update, 1);
   EXPECT_EQ(stats.env_steps, 32);
   EXPECT_EQ(stats.num_episodes, 1);
   EXPECT_FLOAT_EQ(stats.mean_episode_return, 3.0f);
@@ -157,8 +156,8 @@ TEST(LearnerNode, OneBatchFromAFakeActorMakesVersionOneAndPublishesParamsStatsAn
 
   const auto lines = readLines(dir / "metrics.csv");
   ASSERT_EQ(lines.size(), 2u);
-  EXPECT_EQ(lines[0].rfind("epoch,version,env_steps,wall_time_s,fps,return,length,success,term_keypoints", 0), 0u);
-  EXPECT_EQ(lines[1].rfind("0,1,32,", 0), 0u);
+  EXPECT_EQ(lines[0].rfind("update,env_steps,wall_time_s,fps,return,length,success,term_keypoints", 0), 0u);
+  EXPECT_EQ(lines[1].rfind("1,32,", 0), 0u);
   EXPECT_TRUE(fs::exists(dir / "config.yaml"));
   fs::remove_all(dir);
 }
@@ -189,7 +188,7 @@ TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTri
   // The next good batch goes through, and its stats carry the drops.
   actor.send(learner.transport(), 5, 1, 0);
   ASSERT_TRUE(stepUntilUpdate(learner));
-  ASSERT_EQ(stats.version, 1);
+  ASSERT_EQ(stats.update, 1);
   auto countOf = [&](const std::string& name) {
     for (int i = 0; i < stats.num_drop_reasons; ++i)
       if (stats.drop_reason_names[i] == name) return stats.drop_counts[i];
@@ -290,8 +289,8 @@ TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv)
 
   const auto lines = readLines(dir_b / "metrics.csv");
   ASSERT_EQ(lines.size(), 3u);  // one header, the row before the checkpoint, the resumed row
-  EXPECT_EQ(lines[0].rfind("epoch,", 0), 0u);
-  EXPECT_EQ(lines[2].rfind("1,2,64,", 0), 0u);
+  EXPECT_EQ(lines[0].rfind("update,", 0), 0u);
+  EXPECT_EQ(lines[2].rfind("2,64,", 0), 0u);
   fs::remove_all(dir_a);
   fs::remove_all(dir_b);
 }
@@ -311,7 +310,7 @@ TEST(LearnerNode, ResumeCutsMetricsCsvBackToTheCheckpointsUpdate) {
       if (k == 5) fs::copy(dir, saved, fs::copy_options::recursive);  // the checkpoint at update 6
     }
   }
-  ASSERT_EQ(readLines(dir / "metrics.csv").size(), 11u);  // header, rows 0..9
+  ASSERT_EQ(readLines(dir / "metrics.csv").size(), 11u);  // header, updates 1..10
   // The learner died after update 10's row but its newest checkpoint is update 6's.
   fs::copy_file(saved / "checkpoint.bin", dir / "checkpoint.bin", fs::copy_options::overwrite_existing);
   LearnerOptions o = options(dir, 0);
@@ -319,13 +318,13 @@ TEST(LearnerNode, ResumeCutsMetricsCsvBackToTheCheckpointsUpdate) {
   Learner b(rc, o);
   ASSERT_EQ(b.version(), 6);
   auto lines = readLines(dir / "metrics.csv");
-  ASSERT_EQ(lines.size(), 7u) << "header and rows 0..5";
-  for (int k = 0; k < 6; ++k) EXPECT_EQ(lines[k + 1].rfind(std::to_string(k) + ",", 0), 0u) << lines[k + 1];
+  ASSERT_EQ(lines.size(), 7u) << "header and updates 1..6";
+  for (int k = 1; k <= 6; ++k) EXPECT_EQ(lines[k].rfind(std::to_string(k) + ",", 0), 0u) << lines[k];
   actor.send(b.transport(), 9, 6, 6);
   ASSERT_TRUE(stepUntilUpdate(b));
   lines = readLines(dir / "metrics.csv");
   ASSERT_EQ(lines.size(), 8u);
-  EXPECT_EQ(lines[7].rfind("6,7,", 0), 0u) << lines[7];
+  EXPECT_EQ(lines[7].rfind("7,", 0), 0u) << lines[7];
   fs::remove_all(dir);
   fs::remove_all(saved);
 }

@@ -22,12 +22,12 @@ fs::path freshDir(const std::string& name) { return masa::testing::freshTempDir(
 // evaluation of the policy mean every other update (nan between).
 void writeMetrics(const fs::path& dir, int rows) {
   std::ofstream f(dir / "metrics.csv");
-  f << "epoch,version,env_steps,wall_time_s,fps,return,length,success,term_alive,term_velocity,actor_loss,"
+  f << "update,env_steps,wall_time_s,fps,return,length,success,term_alive,term_velocity,actor_loss,"
        "critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped_chunks,"
        "dropped_envs,eval_return,eval_length,eval_success,eval_distance_m\n";
   for (int i = 0; i < rows; ++i) {
     const bool ended = i != 1;
-    f << i << ',' << i + 1 << ',' << (i + 1) * 2048 << ',' << i * 0.5 << ",4000,";
+    f << i + 1 << ',' << (i + 1) * 2048 << ',' << i * 0.5 << ",4000,";
     if (ended)
       f << 10.0 + i << ',' << 20 + i << ",-1," << 0.5 * i << ',' << 1.0 + i;
     else

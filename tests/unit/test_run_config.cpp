@@ -91,6 +91,17 @@ TEST_F(ScratchConfigs, EnvSectionsMergeAcrossTaskFileAndCommandLine) {
   EXPECT_DOUBLE_EQ(c.env["weights"]["velocity"].as<double>(), 1.0);
 }
 
+// The update has one name (issue #32): ppo.max_updates. Files written before, run directories
+// and policy files among them, say ppo.max_epochs, which is read as the same key.
+TEST_F(ScratchConfigs, TheOldNameMaxEpochsIsReadAsMaxUpdates) {
+  writeTask("t", "ppo:\n  max_epochs: 7\n");
+  const RunConfig c = loadRunConfig(dir_.string(), {"task=t"});
+  EXPECT_EQ(c.ppo.max_updates, 7);
+  EXPECT_EQ(loadRunConfig(dir_.string(), {"task=t", "ppo.max_epochs=9"}).ppo.max_updates, 9);
+  EXPECT_EQ(loadRunConfig(dir_.string(), {"task=t", "ppo.max_updates=11"}).ppo.max_updates, 11);
+  EXPECT_EQ(dumpResolved(c).find("max_epochs"), std::string::npos);
+}
+
 TEST_F(ScratchConfigs, UnknownKeyInTaskFileNamesTheFileAndTheKey) {
   const std::string file = writeTask("t", "ppo:\n  learning_rat: 0.1\n");
   const ConfigError e = expectError({"task=t"});

@@ -98,8 +98,7 @@ TEST(TransportTypes, LearnerStatsSurviveMemqRoundTrip) {
   masa::lcmt_learner_stats s{};
   s.run_id = 11;
   s.utime = 123456;
-  s.epoch = 7;
-  s.version = 8;
+  s.update = 8;
   s.env_steps = 1ll << 40;
   s.fps = 61234.5f;
   s.mean_episode_return = 12.5f;
