@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "common/core/check.hpp"
+#include "common/rollout/rollout_fields.hpp"
 #include "common/transport/chunk_layout.hpp"
 
 namespace masa::actor {
@@ -94,20 +95,11 @@ std::span<const masa::lcmt_rollout_chunk> RolloutChunker::split(const rollout::R
     auto length = [&](std::string_view field) { return static_cast<std::size_t>(rollout::chunkLength(field, most)); };
     while (static_cast<int>(chunks_.size()) < num_chunks) {
       masa::lcmt_rollout_chunk& c = chunks_.emplace_back();
-      c.obs.reserve(length("obs_len"));
-      c.actions.reserve(length("act_len"));
-      c.mean.reserve(length("act_len"));
-      c.log_prob.reserve(length("step_len"));
-      c.reward.reserve(length("step_len"));
-      c.terminated.reserve(length("step_len"));
-      c.truncated.reserve(length("step_len"));
-      c.final_index.reserve(length("num_final"));
-      c.final_obs.reserve(length("final_obs_len"));
-      c.episode_env.reserve(length("num_episodes"));
-      c.episode_return.reserve(length("num_episodes"));
-      c.episode_length.reserve(length("num_episodes"));
-      c.episode_success.reserve(length("num_episodes"));
-      c.episode_term_sums.reserve(length("term_sums_len"));
+      rollout::forEachStepArray(c, r.obs_dim, r.act_dim, [&](auto& a, int width, int extra_rows) {
+        a.reserve(static_cast<std::size_t>(r.horizon + extra_rows) * cap * width);
+      });
+      rollout::forEachFinalArray(c, r.obs_dim, [&](auto& a, int width) { a.reserve(length("num_final") * width); });
+      rollout::forEachEpisodeArray(c, r.numTerms(), [&](auto& a, int width) { a.reserve(length("num_episodes") * width); });
     }
   }
   const int empty = emptyChunkBytes(r.act_dim, r.term_names);
@@ -124,23 +116,8 @@ std::span<const masa::lcmt_rollout_chunk> RolloutChunker::split(const rollout::R
   return {chunks_.data(), static_cast<std::size_t>(num_chunks)};
 }
 
-namespace {
-// Copies rows t = 0..rows-1 of n consecutive envs starting at `offset` (dim values each) from an
-// E-env step-major array into an n-env step-major array.
-// (The flags are uint8_t in memory and int8_t on the wire: the same bytes.)
-template <typename D, typename S>
-void copyRows(std::vector<D>& dst, const std::vector<S>& src, int rows, int E, int offset, int n, int dim) {
-  static_assert(sizeof(D) == sizeof(S));
-  const std::size_t row = static_cast<std::size_t>(n) * dim;
-  dst.resize(rows * row);
-  for (int t = 0; t < rows; ++t) {
-    std::memcpy(dst.data() + t * row, src.data() + (static_cast<std::size_t>(t) * E + offset) * dim, row * sizeof(D));
-  }
-}
-}  // namespace
-
 void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const rollout::Rollout& r, const RolloutIdentity& id, int index,
-                          int num_chunks, int offset, int n) const {
+                          int num_chunks, int offset, int n) {
   const int E = r.num_envs, T = r.horizon;
   c.run_id = id.run_id;
   c.actor_id = id.actor_id;
@@ -155,13 +132,15 @@ void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const rollout::Rollout& r
   c.num_envs = n;
   c.env_offset = offset;
 
-  copyRows(c.obs, r.obs, T + 1, E, offset, n, r.obs_dim);
-  copyRows(c.actions, r.actions, T, E, offset, n, r.act_dim);
-  copyRows(c.mean, r.mean, T, E, offset, n, r.act_dim);
-  copyRows(c.log_prob, r.log_prob, T, E, offset, n, 1);
-  copyRows(c.reward, r.reward, T, E, offset, n, 1);
-  copyRows(c.terminated, r.terminated, T, E, offset, n, 1);
-  copyRows(c.truncated, r.truncated, T, E, offset, n, 1);
+  // Environments [offset, offset + n) of the rollout are the chunk's 0..n-1; its episodes name the
+  // actor's environment (env_offset + j), as the wire layout says.
+  env_map_.assign(E, -1);
+  for (int j = 0; j < n; ++j) env_map_[offset + j] = j;
+  const rollout::EnvCopy copy{.horizon = T, .obs_dim = r.obs_dim, .act_dim = r.act_dim, .src_envs = E,
+                             .dst_envs = n, .dst_env = env_map_, .dst_episode_base = offset,
+                             .src_terms = r.numTerms(), .dst_terms = r.numTerms()};
+  rollout::resizeSteps(c, T, n, r.obs_dim, r.act_dim);
+  rollout::copyEnvironmentSteps(r, c, copy);
   c.obs_len = static_cast<int32_t>(c.obs.size());
   c.act_len = static_cast<int32_t>(c.actions.size());
   c.step_len = static_cast<int32_t>(c.log_prob.size());
@@ -174,35 +153,12 @@ void RolloutChunker::fill(masa::lcmt_rollout_chunk& c, const rollout::Rollout& r
   c.log_std_len = static_cast<int32_t>(c.log_std.size());
 
   // Truncations stay in ascending order: the global order is (t, e) and the chunk's envs are a
-  // contiguous range, so filtering keeps (t, local e) ascending.
-  c.final_index.clear();
-  c.final_obs.clear();
-  for (int i = 0; i < r.numFinal(); ++i) {
-    const int t = r.final_index[i] / E, e = r.final_index[i] % E;
-    if (e < offset || e >= offset + n) continue;
-    c.final_index.push_back(t * n + (e - offset));
-    const float* o = r.final_obs.data() + static_cast<std::size_t>(i) * r.obs_dim;
-    c.final_obs.insert(c.final_obs.end(), o, o + r.obs_dim);
-  }
+  // contiguous range, so keeping the source's order keeps (t, local e) ascending.
+  rollout::clearEvents(c);
+  rollout::appendEnvironmentEvents(r, c, copy);
   c.num_final = static_cast<int32_t>(c.final_index.size());
   c.final_obs_len = static_cast<int32_t>(c.final_obs.size());
 
-  const int K = r.numTerms();
-  c.episode_env.clear();
-  c.episode_return.clear();
-  c.episode_length.clear();
-  c.episode_success.clear();
-  c.episode_term_sums.clear();
-  for (int i = 0; i < r.numEpisodes(); ++i) {
-    const int e = r.episode_env[i];
-    if (e < offset || e >= offset + n) continue;
-    c.episode_env.push_back(e);
-    c.episode_return.push_back(r.episode_return[i]);
-    c.episode_length.push_back(r.episode_length[i]);
-    c.episode_success.push_back(r.episode_success[i]);
-    const float* s = r.episode_term_sums.data() + static_cast<std::size_t>(i) * K;
-    c.episode_term_sums.insert(c.episode_term_sums.end(), s, s + K);
-  }
   c.num_episodes = static_cast<int32_t>(c.episode_env.size());
   c.term_names = r.term_names;  // element-wise assignment: reuses the strings' storage
   c.num_terms = static_cast<int32_t>(c.term_names.size());

@@ -56,13 +56,14 @@ class RolloutChunker {
  private:
   void plan(const rollout::Rollout& r);
   void fill(masa::lcmt_rollout_chunk& c, const rollout::Rollout& r, const RolloutIdentity& id, int index,
-            int num_chunks, int offset, int n) const;
+            int num_chunks, int offset, int n);
 
   int budget_;
   long oversize_ = 0;
   std::vector<masa::lcmt_rollout_chunk> chunks_;
   std::vector<int> env_finals_, env_episodes_;  // per environment, this rollout
   std::vector<int> chunk_offset_, chunk_envs_;  // the plan
+  std::vector<int> env_map_;                    // rollout environment -> chunk environment (or -1), for fill
 };
 
 }  // namespace masa::actor

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "common/core/check.hpp"
+#include "common/rollout/rollout_fields.hpp"
 
 namespace masa::learner {
 
@@ -106,8 +107,6 @@ void BatchCollector::add(const ValidatedChunk& chunk) {
     stats_.envs_stale += n;
     return;
   }
-  const int K = pool_.numTerms();
-  const bool terms_match = m.num_terms == K;
   rollout::Rollout& p = pool_;
   dropEventsOfFreeSlots();  // before free slots are reused: their events are their previous owners'
   chunk_slots_.assign(n, -1);
@@ -125,42 +124,15 @@ void BatchCollector::add(const ValidatedChunk& chunk) {
     slot_arrival_[s] = arrivals_++;
     slot_actor_[s] = m.actor_id;
     slot_env_[s] = m.env_offset + j;
-    // Same layout on both sides: environment j of the chunk becomes column s of the pool.
-    for (int t = 0; t <= T; ++t) {
-      std::memcpy(p.obsAt(t, s), &m.obs[(static_cast<std::size_t>(t) * n + j) * od], od * sizeof(float));
-    }
-    for (int t = 0; t < T; ++t) {
-      const std::size_t src = static_cast<std::size_t>(t) * n + j, dst = p.step(t, s);
-      std::memcpy(p.actionAt(t, s), &m.actions[src * ad], ad * sizeof(float));
-      std::memcpy(p.meanAt(t, s), &m.mean[src * ad], ad * sizeof(float));
-      p.log_prob[dst] = m.log_prob[src];
-      p.reward[dst] = m.reward[src];
-      p.terminated[dst] = static_cast<uint8_t>(m.terminated[src]);
-      p.truncated[dst] = static_cast<uint8_t>(m.truncated[src]);
-    }
     std::memcpy(p.logStdOf(s), m.log_std.data(), ad * sizeof(float));
   }
-  // Truncations and episodes follow their environment into its slot (if it got one).
-  for (int i = 0; i < m.num_final; ++i) {
-    const int t = m.final_index[i] / n, j = m.final_index[i] % n;
-    const int s = chunk_slots_[j];
-    if (s < 0) continue;
-    p.final_index.push_back(static_cast<int32_t>(p.step(t, s)));
-    const float* obs = &m.final_obs[static_cast<std::size_t>(i) * od];
-    p.final_obs.insert(p.final_obs.end(), obs, obs + od);
-  }
-  for (int i = 0; i < m.num_episodes; ++i) {
-    const int s = chunk_slots_[m.episode_env[i] - m.env_offset];
-    if (s < 0) continue;
-    p.episode_env.push_back(s);
-    p.episode_return.push_back(m.episode_return[i]);
-    p.episode_length.push_back(m.episode_length[i]);
-    p.episode_success.push_back(m.episode_success[i]);
-    // A chunk with other reward terms keeps its returns, not its terms.
-    for (int k = 0; k < K; ++k) {
-      p.episode_term_sums.push_back(terms_match ? m.episode_term_sums[static_cast<std::size_t>(i) * K + k] : 0.0f);
-    }
-  }
+  // Same layout on both sides: environment j of the chunk becomes column s of the pool, and its
+  // truncations and episodes follow it (if it got a slot).
+  const rollout::EnvCopy copy{.horizon = T, .obs_dim = od, .act_dim = ad, .src_envs = n,
+                             .dst_envs = capacity_, .dst_env = chunk_slots_, .src_episode_base = m.env_offset,
+                             .src_terms = m.num_terms, .dst_terms = pool_.numTerms()};
+  rollout::copyEnvironmentSteps(m, p, copy);
+  rollout::appendEnvironmentEvents(m, p, copy);
 }
 
 bool BatchCollector::take(ppo::RolloutBuffer& out, BatchOrigin* origin) {
@@ -207,16 +179,6 @@ void BatchCollector::takeEnvs(ppo::RolloutBuffer& out, int B, BatchOrigin* origi
   for (int b = 0; b < B; ++b) {
     const int s = order_[b];
     batch_column_[s] = b;
-    for (int t = 0; t <= T; ++t) std::memcpy(d.obsAt(t, b), p.obsAt(t, s), od * sizeof(float));
-    for (int t = 0; t < T; ++t) {
-      const std::size_t src = p.step(t, s), dst = d.step(t, b);
-      std::memcpy(d.actionAt(t, b), p.actionAt(t, s), ad * sizeof(float));
-      std::memcpy(d.meanAt(t, b), p.meanAt(t, s), ad * sizeof(float));
-      d.log_prob[dst] = p.log_prob[src];
-      d.reward[dst] = p.reward[src];
-      d.terminated[dst] = p.terminated[src];
-      d.truncated[dst] = p.truncated[src];
-    }
     std::memcpy(d.logStdOf(b), p.logStdOf(s), ad * sizeof(float));
     if (origin) {
       origin->env_version[b] = slot_version_[s];
@@ -224,22 +186,12 @@ void BatchCollector::takeEnvs(ppo::RolloutBuffer& out, int B, BatchOrigin* origi
       origin->env_index[b] = slot_env_[s];
     }
   }
-  // Events of the chosen slots, renumbered to batch columns; truncations in ascending step order.
-  batch_finals_.clear();
-  for (int i = 0; i < p.numFinal(); ++i) {
-    const int s = p.final_index[i] % C, t = p.final_index[i] / C;
-    if (batch_column_[s] >= 0) batch_finals_.emplace_back(static_cast<int32_t>(d.step(t, batch_column_[s])), i);
-  }
-  std::sort(batch_finals_.begin(), batch_finals_.end());
-  for (const auto& [idx, i] : batch_finals_) d.addFinal(idx / B, idx % B, p.finalObs(i));
-  const int K = p.numTerms();
-  for (int i = 0; i < p.numEpisodes(); ++i) {
-    const int b = batch_column_[p.episode_env[i]];
-    if (b >= 0) {
-      d.addEpisode(b, p.episode_return[i], p.episode_length[i], p.episode_success[i],
-                   K > 0 ? &p.episode_term_sums[static_cast<std::size_t>(i) * K] : nullptr);
-    }
-  }
+  // The chosen slots become batch columns, their events renumbered; truncations in ascending order.
+  const rollout::EnvCopy copy{.horizon = T, .obs_dim = od, .act_dim = ad, .src_envs = C, .dst_envs = B,
+                             .dst_env = batch_column_, .src_terms = p.numTerms(), .dst_terms = p.numTerms()};
+  rollout::copyEnvironmentSteps(p, d, copy);
+  rollout::appendEnvironmentEvents(p, d, copy);
+  rollout::sortFinals(d, od, batch_finals_, sorted_final_obs_);
   for (int b = 0; b < B; ++b) {
     batch_column_[order_[b]] = -1;
     release(order_[b]);

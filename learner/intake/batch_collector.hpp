@@ -93,7 +93,8 @@ class BatchCollector {
   std::vector<int32_t> slot_actor_, slot_env_;
   std::vector<int> free_, order_, batch_column_;
   std::vector<int> chunk_slots_;                          // slot of each environment of the chunk being added
-  std::vector<std::pair<int32_t, int32_t>> batch_finals_;  // (batch step index, pool final entry)
+  std::vector<std::pair<int32_t, int32_t>> batch_finals_;  // scratch of sortFinals: (batch step index, entry)
+  std::vector<float> sorted_final_obs_;                   // scratch of sortFinals
 };
 
 }  // namespace masa::learner

@@ -7,9 +7,11 @@
 #include <new>
 #include <stdexcept>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include "common/core/check.hpp"
+#include "common/rollout/rollout_fields.hpp"
 #include "common/transport/chunk_layout.hpp"
 
 namespace masa::learner {
@@ -28,6 +30,12 @@ bool allFinite(const std::vector<float>& v) {
   return bad == 0;
 }
 
+template <typename V>
+bool allFiniteIfFloat(const V& v) {
+  if constexpr (std::is_same_v<V, std::vector<float>>) return allFinite(v);
+  return true;
+}
+
 bool allFlags(const std::vector<int8_t>& v) {
   uint8_t bad = 0;
   for (int8_t x : v) bad |= static_cast<uint8_t>(x != 0 && x != 1);
@@ -42,22 +50,10 @@ bool sizeIs(const V& v, int64_t n) {
 void clearArrays(masa::lcmt_rollout_chunk& m) {
   // The generated decoder leaves an array untouched when its length is 0, so a reused message
   // would keep the previous chunk's contents there.
-  m.obs.clear();
-  m.actions.clear();
-  m.mean.clear();
-  m.log_prob.clear();
-  m.reward.clear();
-  m.terminated.clear();
-  m.truncated.clear();
+  rollout::forEachStepArray(m, 1, 1, [](auto& a, int, int) { a.clear(); });
+  rollout::clearEvents(m);
   m.log_std.clear();
-  m.final_index.clear();
-  m.final_obs.clear();
-  m.episode_env.clear();
-  m.episode_return.clear();
-  m.episode_length.clear();
-  m.episode_success.clear();
   m.term_names.clear();
-  m.episode_term_sums.clear();
 }
 
 }  // namespace
@@ -100,15 +96,17 @@ DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
   for (const auto& [field, value] : lengths) {
     if (value != rollout::chunkLength(field, shape)) return DropReason::kBadLength;
   }
-  if (!sizeIs(m.obs, m.obs_len) || !sizeIs(m.actions, m.act_len) || !sizeIs(m.mean, m.act_len) ||
-      !sizeIs(m.log_prob, m.step_len) || !sizeIs(m.reward, m.step_len) || !sizeIs(m.terminated, m.step_len) ||
-      !sizeIs(m.truncated, m.step_len) || !sizeIs(m.log_std, m.log_std_len) || !sizeIs(m.final_index, m.num_final) ||
-      !sizeIs(m.final_obs, m.final_obs_len) || !sizeIs(m.episode_env, m.num_episodes) ||
-      !sizeIs(m.episode_return, m.num_episodes) || !sizeIs(m.episode_length, m.num_episodes) ||
-      !sizeIs(m.episode_success, m.num_episodes) || !sizeIs(m.term_names, m.num_terms) ||
-      !sizeIs(m.episode_term_sums, m.term_sums_len)) {
-    return DropReason::kBadLength;
-  }
+  // Every array at the size of its field in the rollout's one list (common/rollout/rollout_fields.hpp),
+  // which the length fields, checked above, also say.
+  bool sizes = sizeIs(m.log_std, m.log_std_len) && sizeIs(m.term_names, m.num_terms);
+  rollout::forEachStepArray(m, od, ad, [&](const auto& a, int width, int extra_rows) {
+    sizes = sizes && sizeIs(a, (T + extra_rows) * n * width);
+  });
+  rollout::forEachFinalArray(m, od, [&](const auto& a, int width) { sizes = sizes && sizeIs(a, m.num_final * int64_t{width}); });
+  rollout::forEachEpisodeArray(m, m.num_terms, [&](const auto& a, int width) {
+    sizes = sizes && sizeIs(a, m.num_episodes * int64_t{width});
+  });
+  if (!sizes) return DropReason::kBadLength;
 
   if (m.policy_version > version_) return DropReason::kFutureVersion;
   if (m.policy_version < version_ - cfg_.max_policy_lag) return DropReason::kTooOld;
@@ -132,11 +130,12 @@ DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
     }
   }
 
-  if (!allFinite(m.obs) || !allFinite(m.actions) || !allFinite(m.mean) || !allFinite(m.log_prob) ||
-      !allFinite(m.reward) || !allFinite(m.log_std) || !allFinite(m.final_obs) || !allFinite(m.episode_return) ||
-      !allFinite(m.episode_term_sums)) {
-    return DropReason::kNonFinite;
-  }
+  // Every float the chunk carries is finite.
+  bool finite = allFinite(m.log_std);
+  rollout::forEachStepArray(m, od, ad, [&](const auto& a, int, int) { finite = finite && allFiniteIfFloat(a); });
+  rollout::forEachFinalArray(m, od, [&](const auto& a, int) { finite = finite && allFiniteIfFloat(a); });
+  rollout::forEachEpisodeArray(m, m.num_terms, [&](const auto& a, int) { finite = finite && allFiniteIfFloat(a); });
+  if (!finite) return DropReason::kNonFinite;
   return DropReason::kAccepted;
 }
 
