@@ -81,6 +81,10 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
 
   model_ = std::make_unique<model::ActorCritic<float>>(spec, config_.model);
   policy_param_count_ = model_->policyParamCount();
+  params_check_ = std::make_unique<ParamsCheck>(ParamsExpectation{
+      .run_id = options_.run_id, .task = config_.task, .method = model::methodName(config_.method),
+      .policy_param_count = policy_param_count_, .model_param_count = static_cast<int>(model_->params().size()),
+      .obs_dim = obs_dim_, .max_version_step = options_.max_version_step});
   {
     // Own initial parameters: used only with start_without_learner, and deterministic per seed.
     Rng init_rng = envRng(config_.seed, options_.actor_id, -1);
@@ -118,7 +122,7 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
 Actor::~Actor() = default;
 
 void Actor::onParams(const masa::lcmt_policy_params& m) {
-  if (m.run_id != options_.run_id) return;  // another run on the same network
+  if (!params_check_->ofThisRun(m)) return;  // another run on the same network
   const int64_t newest = std::max(version_, pending_version_);
   if (m.version == newest) {  // the learner's periodic repeat: it is alive, and agrees with us
     last_learner_s_ = nowSeconds();
@@ -126,28 +130,8 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
     return;
   }
   const bool behind = m.version < newest;
-  auto reject = [&](const std::string& why) { rejectParams(m.version, why); };
-  if (!behind && m.version - std::max<int64_t>(newest, 0) > options_.max_version_step)
-    return reject("more than " + std::to_string(options_.max_version_step) + " versions ahead of " +
-                  std::to_string(std::max<int64_t>(newest, 0)));
-  if (m.task != config_.task) return reject("task '" + m.task + "', this actor runs '" + config_.task + "'");
-  if (m.method != model::methodName(config_.method))
-    return reject("method '" + m.method + "', this actor builds '" + model::methodName(config_.method) + "'");
+  if (const auto why = params_check_->refusal(m, newest)) return rejectParams(m.version, *why);
   const int n = m.num_params;
-  if (n != model_->params().size() && n != policy_param_count_)
-    return reject("num_params " + std::to_string(n) + ", expected " + std::to_string(policy_param_count_) +
-                  " (policy) or " + std::to_string(model_->params().size()) + " (whole model)");
-  if (static_cast<int>(m.params.size()) != n) return reject("params array length differs from num_params");
-  // obs_dim 0: the learner does not normalize; the actor's normalizer stays at identity.
-  if (m.obs_dim != 0 && m.obs_dim != obs_dim_)
-    return reject("obs_dim " + std::to_string(m.obs_dim) + ", expected " + std::to_string(obs_dim_));
-  if (static_cast<int>(m.obs_mean.size()) != m.obs_dim || static_cast<int>(m.obs_std.size()) != m.obs_dim)
-    return reject("normalizer arrays differ from obs_dim");
-  for (float v : m.params)
-    if (!std::isfinite(v)) return reject("non-finite parameter");
-  for (int d = 0; d < m.obs_dim; ++d)
-    if (!std::isfinite(m.obs_mean[d]) || !std::isfinite(m.obs_std[d]) || !(m.obs_std[d] > 0.0f))
-      return reject("bad normalizer entry " + std::to_string(d));
   if (behind) {
     // Usually a late copy of older parameters: ignored. But when valid parameters below ours keep
     // coming, with none at our version in between, ours were never the learner's: on a network

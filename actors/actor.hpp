@@ -23,6 +23,7 @@
 #include "common/model/actor_critic.hpp"
 #include "common/sim/registry.hpp"
 #include "actors/await_budget.hpp"
+#include "actors/params_check.hpp"
 #include "common/rollout/rollout.hpp"
 #include "actors/rollout_chunker.hpp"
 #include "common/transport/transport.hpp"
@@ -154,6 +155,7 @@ class Actor {
   std::vector<Rng> rngs_;
   std::unique_ptr<model::ActorCritic<float>> model_;
   int policy_param_count_ = 0;  // the policy + log-std prefix of the flat parameters
+  std::unique_ptr<ParamsCheck> params_check_;  // made once the model's sizes are known
   rollout::Rollout rollout_;
   RolloutChunker chunker_;
   int obs_dim_, act_dim_, num_terms_;
