@@ -18,6 +18,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <regex>
 #include <sstream>
 
@@ -280,6 +281,272 @@ struct TaskResult {
   std::vector<Metric> metrics;  // drawn against steps; metrics[0] is the training return
 };
 
+// One run's figures over the budget.
+struct Summary {
+  double auc, final_return, final_eval, wall;
+};
+
+// The verdict's table of the reference against each baseline: bootstrap intervals of the
+// differences in mean return over the budget and in final evaluation return, when the reference
+// reaches the baseline's final return, and the call.
+void writeBaselines(std::ostream& verdict, const std::string& reference, const std::vector<std::string>& methods,
+                    std::map<std::string, std::vector<Summary>>& summaries, const Band& rb, double budget,
+                    int resamples) {
+  verdict << "| baseline | " << reference << " - baseline: mean return over budget [95%] | " << reference
+          << " - baseline: final eval return [95%] | " << reference
+          << " reaches the baseline's final return at | verdict |\n|---|---|---|---|---|\n";
+  for (const auto& base : methods) {
+    if (base == reference) continue;
+    auto pick = [&](const std::string& m, double Summary::*f) {
+      std::vector<double> v;
+      for (const auto& s : summaries[m])
+        if (!std::isnan(s.*f)) v.push_back(s.*f);
+      return v;
+    };
+    Rng rng(12345);
+    const auto a_auc = pick(reference, &Summary::auc), b_auc = pick(base, &Summary::auc);
+    const auto a_ev = pick(reference, &Summary::final_eval), b_ev = pick(base, &Summary::final_eval);
+    if (a_auc.empty() || b_auc.empty()) {  // no episode ended within the budget
+      verdict << "| " << base << " | n/a | n/a | n/a | no finished episodes to compare |\n";
+      continue;
+    }
+    const auto auc = stats::bootstrapMeanDifference(a_auc, b_auc, resamples, 0.95, rng);
+    std::string ev_text = "n/a";
+    stats::Interval ev{kNaN, kNaN, kNaN};
+    if (!a_ev.empty() && !b_ev.empty()) {
+      ev = stats::bootstrapMeanDifference(a_ev, b_ev, resamples, 0.95, rng);
+      ev_text = fmt(ev.estimate) + " [" + fmt(ev.low) + ", " + fmt(ev.high) + "]";
+    }
+    const double level = stats::median(pick(base, &Summary::final_return));
+    const double reach = stats::firstCrossing(rb.steps, rb.median, level);
+    std::string reach_text = std::isnan(reach) ? "not within the budget (" + fmt(level) + ")"
+                                               : millions(reach) + " (" + fmt(100.0 * reach / budget, 0) +
+                                                     "% of the budget; level " + fmt(level) + ")";
+    const size_t n = std::min(a_auc.size(), b_auc.size());
+    std::string call;
+    auto side = [&](const stats::Interval& iv) {
+      return iv.low > 0 ? 1 : iv.high < 0 ? -1 : 0;
+    };
+    if (n < 3) {
+      call = "too few seeds (" + std::to_string(n) + ") to tell";
+    } else {
+      const int s_auc = side(auc), s_ev = std::isnan(ev.low) ? 0 : side(ev);
+      if (s_auc > 0 && s_ev >= 0) call = reference + " ahead (learns faster" + (s_ev > 0 ? ", ends higher)" : ")");
+      else if (s_auc < 0 && s_ev <= 0) call = base + " ahead (" + reference + "'s ordering does not hold)";
+      else if (s_auc == 0 && s_ev == 0) call = "cannot tell at this budget";
+      else if (s_auc == 0) call = (s_ev > 0 ? reference : base) + " ends higher; learning speed cannot be told apart";
+      else call = "mixed: " + std::string(s_auc > 0 ? reference : base) + " learns faster, " +
+                  (s_ev > 0 ? reference : base) + " ends higher";
+    }
+    verdict << "| " << base << " | " << fmt(auc.estimate) << " [" << fmt(auc.low) << ", " << fmt(auc.high)
+            << "] | " << ev_text << " | " << reach_text << " | " << call << " |\n";
+  }
+  verdict << "\n";
+}
+
+// The verdict's table of one milestone for one task: the env steps at which each run first
+// reaches the level; a run that never does counts as later than any that does.
+void writeMilestone(std::ostream& verdict, Milestone& ms, const std::string& task, const Run& any,
+                    const std::vector<std::string>& methods, const std::map<std::string, std::vector<const Run*>>& used,
+                    double budget, const std::string& reference, int resamples) {
+  if (!any.columns.count(ms.column)) {
+    if (!ms.task.empty()) ms.unmatched = task + "'s metrics.csv has no column '" + ms.column + "'";
+    return;
+  }
+  ms.matched = true;
+  verdict << "Milestone " << ms.column << " >= " << shortest(ms.level)
+          << ": the env steps of the first row at which it holds (an evaluation figure is known only "
+          << "at the evaluations); a seed that never reaches it within the budget counts as later than "
+          << "any that does.\n\n| method | seeds that reach it | per seed | median | " << reference
+          << " - method: steps [95%] |\n|---|---|---|---|---|\n";
+  std::map<std::string, std::vector<double>> reached;  // NaN: not within the budget
+  for (const auto& m : methods)
+    for (const Run* r : used.at(m))
+      reached[m].push_back(stats::firstReached(r->col("env_steps"), r->col(ms.column), ms.level, budget));
+  auto allReached = [](const std::vector<double>& v) {
+    return std::none_of(v.begin(), v.end(), [](double x) { return std::isnan(x); });
+  };
+  for (const auto& m : methods) {
+    const auto& v = reached[m];
+    std::vector<double> sorted;  // a run that never reached it is beyond any that did
+    std::string per_seed;
+    int count = 0;
+    for (size_t i = 0; i < v.size(); ++i) {
+      count += !std::isnan(v[i]);
+      sorted.push_back(std::isnan(v[i]) ? std::numeric_limits<double>::infinity() : v[i]);
+      per_seed += (i ? ", s" : "s") + std::to_string(used.at(m)[i]->seed) + " " + steps(v[i]);
+    }
+    // The median by hand: interpolating towards "never" (infinity) would give NaN.
+    std::sort(sorted.begin(), sorted.end());
+    const size_t n = sorted.size();
+    const double med = n == 0       ? std::numeric_limits<double>::infinity()
+                       : n % 2 ? sorted[n / 2]
+                               : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+    std::string diff;
+    if (m != reference && reached.count(reference)) {
+      const auto& a = reached[reference];
+      if (allReached(a) && allReached(v) && !a.empty() && !v.empty()) {
+        Rng rng(12345);
+        const auto iv = stats::bootstrapMeanDifference(a, v, resamples, 0.95, rng);
+        diff = steps(iv.estimate) + " [" + steps(iv.low) + ", " + steps(iv.high) + "]";
+      } else {
+        diff = "n/a (a seed never reached it)";
+      }
+    }
+    verdict << "| " << m << " | " << count << " of " << v.size() << " | " << per_seed << " | "
+            << (std::isinf(med) ? "not within the budget" : steps(med)) << " | " << diff << " |\n";
+  }
+  verdict << "\n";
+}
+
+// A task's figure (a gnuplot script): each metric against env steps, the training return against time.
+void writeTaskFigure(const fs::path& path, const std::string& task, const std::vector<Metric>& metrics,
+                     const std::vector<std::string>& methods, size_t most_seeds) {
+  const size_t panels = metrics.size() + 1;
+  const int cols = panels > 2 ? 2 : static_cast<int>(panels);
+  const int rows_ = static_cast<int>((panels + cols - 1) / cols);
+  std::ofstream gp(path);
+  gp << "# " << task << ": median and 25-75% band over seeds. Redraw here with: gnuplot compare.gp\n"
+     << "set terminal pngcairo size " << 700 * cols << "," << 450 * rows_ << " font ',10'\n"
+     << "set output 'compare.png.tmp'\nset termoption noenhanced\n"
+     << "set style fill transparent solid 0.2 noborder\nset grid\nset key bottom right\n"
+     << "set multiplot layout " << rows_ << "," << cols << " title '" << task << ": median and 25-75% over "
+     << most_seeds << " seeds per method'\n";
+  bool keys = true;
+  for (const auto& metric : metrics) {
+    gp << "set title '" << metric.label << "'\nset xlabel 'env steps (millions)'\n"
+       << panel("", metric.column, methods, false, keys);
+    keys = false;
+  }
+  gp << "set title 'training return against wall-clock time (one core per run)'\nset xlabel 'minutes'\n"
+     << panel("", "return", methods, true, false);
+  gp << "unset multiplot\nset output\nsystem('mv -f compare.png.tmp compare.png')\n";
+  gp.close();
+}
+
+// One task of the grid: its curves, runs.csv, its section of the verdict (medians, each baseline
+// against the reference, the milestones) and its figure's gnuplot script. Nothing when it has no runs.
+std::optional<TaskResult> compareTask(const fs::path& dir, const std::string& task, const std::string& reference,
+                                      int resamples, std::vector<Milestone>& milestones, std::ostream& verdict) {
+  const std::regex run_name("(.+)_s([0-9]+)");
+  std::map<std::string, std::vector<Run>> by_method;
+  for (const auto& e : fs::directory_iterator(dir / task)) {
+    std::smatch m;
+    const std::string name = e.path().filename().string();
+    if (!e.is_directory() || !std::regex_match(name, m, run_name)) continue;
+    if (!fs::exists(e.path() / "metrics.csv")) continue;
+    Run run = readRun(e.path() / "metrics.csv");
+    if (run.rows() < 2) continue;
+    run.method = m[1];
+    run.seed = std::stoi(m[2]);
+    run.done = fs::exists(e.path() / "done");
+    by_method[run.method].push_back(std::move(run));
+  }
+  if (by_method.empty()) return std::nullopt;
+  std::vector<std::string> found;
+  for (auto& [m, runs] : by_method) {
+    found.push_back(m);
+    std::sort(runs.begin(), runs.end(), [](const Run& a, const Run& b) { return a.seed < b.seed; });
+  }
+  const auto methods = methodOrder(dir, found, reference);
+
+  // Finished runs only, once every method has one; until then every run, said so.
+  bool all_done = true;
+  for (const auto& [m, runs] : by_method)
+    all_done = all_done && std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.done; });
+  std::map<std::string, std::vector<const Run*>> used;
+  double budget = std::numeric_limits<double>::infinity();
+  for (const auto& [m, runs] : by_method)
+    for (const auto& r : runs)
+      if (r.done || !all_done) {
+        used[m].push_back(&r);
+        budget = std::min(budget, r.col("env_steps").back());
+      }
+
+  // The metrics: training return, evaluation return, the task's progress figures, success.
+  const Run& any = *used.begin()->second.front();
+  std::vector<Metric> metrics = {{"return", "training return (trailing mean of 5 updates)", true}};
+  auto hasValues = [&](const std::string& c, double min) {
+    for (const auto& [m, runs] : used)
+      for (const Run* r : runs)
+        for (double v : r->col(c))
+          if (!std::isnan(v) && v >= min) return true;
+    return false;
+  };
+  if (hasValues("eval_return", -1e300)) metrics.push_back({"eval_return", "evaluation return (policy mean)", false});
+  for (const auto& [c, values] : any.columns)
+    if (c.rfind("eval_", 0) == 0 && c != "eval_return" && c != "eval_length" && c != "eval_success" &&
+        hasValues(c, -1e300))
+      metrics.push_back({c, "evaluation " + c.substr(5), false});
+  if (hasValues("eval_success", 0.0)) metrics.push_back({"eval_success", "evaluation success rate", false});
+
+  fs::create_directories(dir / task / "curves");
+  std::ofstream curves(dir / task / "curves.csv");
+  curves << "method,metric,env_steps,wall_s,median,q25,q75,n\n";
+  std::map<std::string, Band> return_band;
+  for (const auto& metric : metrics) {
+    for (const auto& m : methods) {
+      const Band b = bandOf(used[m], metric);
+      if (metric.column == "return") return_band[m] = b;
+      std::ofstream dat(dir / task / "curves" / (metric.column + "_" + m + ".dat"));
+      dat << "# " << task << " " << m << " " << metric.column << ": env_steps wall_s median q25 q75 n\n";
+      for (size_t k = 0; k < b.steps.size(); ++k) {
+        dat << b.steps[k] << ' ' << b.wall[k] << ' ' << b.median[k] << ' ' << b.q25[k] << ' ' << b.q75[k] << ' '
+            << b.n[k] << '\n';
+        curves << m << ',' << metric.column << ',' << b.steps[k] << ',' << b.wall[k] << ',' << b.median[k] << ','
+               << b.q25[k] << ',' << b.q75[k] << ',' << b.n[k] << '\n';
+      }
+    }
+  }
+
+  // One row per run.
+  std::map<std::string, std::vector<Summary>> summaries;
+  std::ofstream runs_csv(dir / task / "runs.csv");
+  runs_csv << "method,seed,done,updates,env_steps,wall_s,mean_return_over_budget,final_return,final_eval_return\n";
+  for (const auto& m : methods)
+    for (const Run* r : used[m]) {
+      Summary s;
+      s.auc = stats::meanUnderCurve(r->col("env_steps"), r->col("return"), budget);
+      s.final_return = finalReturn(*r, budget);
+      s.final_eval = lastValue(*r, "eval_return", budget);
+      s.wall = r->col("wall_time_s").back();
+      summaries[m].push_back(s);
+      runs_csv << m << ',' << r->seed << ',' << (r->done ? 1 : 0) << ',' << r->rows() << ','
+               << r->col("env_steps").back() << ',' << s.wall << ',' << s.auc << ',' << s.final_return << ','
+               << s.final_eval << '\n';
+    }
+
+  // The verdict against each baseline.
+  size_t most_seeds = 0;
+  for (const auto& [m, runs] : used) most_seeds = std::max(most_seeds, runs.size());
+  verdict << "## " << task << "\n\nBudget " << millions(budget) << " env steps per run"
+          << (all_done ? "" : " (unfinished runs included: not every method has a finished run)") << ".\n\n";
+  verdict << "| method | seeds | mean return over budget (median) | final return (median) | final eval return "
+             "(median) | wall time (median) |\n|---|---|---|---|---|---|\n";
+  for (const auto& m : methods) {
+    std::vector<double> auc, fin, ev, wall;
+    for (const auto& s : summaries[m]) {
+      auc.push_back(s.auc);
+      fin.push_back(s.final_return);
+      if (!std::isnan(s.final_eval)) ev.push_back(s.final_eval);
+      wall.push_back(s.wall);
+    }
+    verdict << "| " << m << " | " << used[m].size() << " | " << fmt(stats::median(auc)) << " | "
+            << fmt(stats::median(fin)) << " | " << fmt(stats::median(ev)) << " | "
+            << fmt(stats::median(wall) / 60.0) << " min |\n";
+  }
+  verdict << "\n";
+  if (by_method.count(reference)) writeBaselines(verdict, reference, methods, summaries, return_band.at(reference), budget, resamples);
+
+  for (auto& ms : milestones)
+    if (ms.task.empty() || ms.task == task) writeMilestone(verdict, ms, task, any, methods, used, budget, reference, resamples);
+
+  writeTaskFigure(dir / task / "compare.gp", task, metrics, methods, most_seeds);
+  std::printf("masa_compare: %s: %zu methods, up to %zu seeds, budget %s steps -> %s\n", task.c_str(),
+              methods.size(), most_seeds, millions(budget).c_str(), (dir / task / "compare.png").c_str());
+  return TaskResult{task, methods, metrics};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -302,7 +569,6 @@ int main(int argc, char** argv) {
     const fs::path dir = fs::absolute(dir_arg);
     if (!fs::is_directory(dir)) throw std::runtime_error(dir_arg + ": no such directory");
     std::vector<Milestone> milestones = readMilestones(dir, milestone_texts);
-    const std::regex run_name("(.+)_s([0-9]+)");
     std::vector<std::string> task_names;
     for (const auto& e : fs::directory_iterator(dir))
       if (e.is_directory()) task_names.push_back(e.path().filename().string());
@@ -320,246 +586,9 @@ int main(int argc, char** argv) {
             << "that includes it cannot tell at this budget.\n\n";
     std::vector<TaskResult> drawn;
 
-    for (const auto& task : task_names) {
-      std::map<std::string, std::vector<Run>> by_method;
-      for (const auto& e : fs::directory_iterator(dir / task)) {
-        std::smatch m;
-        const std::string name = e.path().filename().string();
-        if (!e.is_directory() || !std::regex_match(name, m, run_name)) continue;
-        if (!fs::exists(e.path() / "metrics.csv")) continue;
-        Run run = readRun(e.path() / "metrics.csv");
-        if (run.rows() < 2) continue;
-        run.method = m[1];
-        run.seed = std::stoi(m[2]);
-        run.done = fs::exists(e.path() / "done");
-        by_method[run.method].push_back(std::move(run));
-      }
-      if (by_method.empty()) continue;
-      std::vector<std::string> found;
-      for (auto& [m, runs] : by_method) {
-        found.push_back(m);
-        std::sort(runs.begin(), runs.end(), [](const Run& a, const Run& b) { return a.seed < b.seed; });
-      }
-      const auto methods = methodOrder(dir, found, reference);
-
-      // Finished runs only, once every method has one; until then every run, said so.
-      bool all_done = true;
-      for (const auto& [m, runs] : by_method)
-        all_done = all_done && std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.done; });
-      std::map<std::string, std::vector<const Run*>> used;
-      double budget = std::numeric_limits<double>::infinity();
-      for (const auto& [m, runs] : by_method)
-        for (const auto& r : runs)
-          if (r.done || !all_done) {
-            used[m].push_back(&r);
-            budget = std::min(budget, r.col("env_steps").back());
-          }
-
-      // The metrics: training return, evaluation return, the task's progress figures, success.
-      const Run& any = *used.begin()->second.front();
-      std::vector<Metric> metrics = {{"return", "training return (trailing mean of 5 updates)", true}};
-      auto hasValues = [&](const std::string& c, double min) {
-        for (const auto& [m, runs] : used)
-          for (const Run* r : runs)
-            for (double v : r->col(c))
-              if (!std::isnan(v) && v >= min) return true;
-        return false;
-      };
-      if (hasValues("eval_return", -1e300)) metrics.push_back({"eval_return", "evaluation return (policy mean)", false});
-      for (const auto& [c, values] : any.columns)
-        if (c.rfind("eval_", 0) == 0 && c != "eval_return" && c != "eval_length" && c != "eval_success" &&
-            hasValues(c, -1e300))
-          metrics.push_back({c, "evaluation " + c.substr(5), false});
-      if (hasValues("eval_success", 0.0)) metrics.push_back({"eval_success", "evaluation success rate", false});
-
-      fs::create_directories(dir / task / "curves");
-      std::ofstream curves(dir / task / "curves.csv");
-      curves << "method,metric,env_steps,wall_s,median,q25,q75,n\n";
-      std::map<std::string, Band> return_band;
-      for (const auto& metric : metrics) {
-        for (const auto& m : methods) {
-          const Band b = bandOf(used[m], metric);
-          if (metric.column == "return") return_band[m] = b;
-          std::ofstream dat(dir / task / "curves" / (metric.column + "_" + m + ".dat"));
-          dat << "# " << task << " " << m << " " << metric.column << ": env_steps wall_s median q25 q75 n\n";
-          for (size_t k = 0; k < b.steps.size(); ++k) {
-            dat << b.steps[k] << ' ' << b.wall[k] << ' ' << b.median[k] << ' ' << b.q25[k] << ' ' << b.q75[k] << ' '
-                << b.n[k] << '\n';
-            curves << m << ',' << metric.column << ',' << b.steps[k] << ',' << b.wall[k] << ',' << b.median[k] << ','
-                   << b.q25[k] << ',' << b.q75[k] << ',' << b.n[k] << '\n';
-          }
-        }
-      }
-
-      // One row per run.
-      struct Summary { double auc, final_return, final_eval, wall; };
-      std::map<std::string, std::vector<Summary>> summaries;
-      std::ofstream runs_csv(dir / task / "runs.csv");
-      runs_csv << "method,seed,done,updates,env_steps,wall_s,mean_return_over_budget,final_return,final_eval_return\n";
-      for (const auto& m : methods)
-        for (const Run* r : used[m]) {
-          Summary s;
-          s.auc = stats::meanUnderCurve(r->col("env_steps"), r->col("return"), budget);
-          s.final_return = finalReturn(*r, budget);
-          s.final_eval = lastValue(*r, "eval_return", budget);
-          s.wall = r->col("wall_time_s").back();
-          summaries[m].push_back(s);
-          runs_csv << m << ',' << r->seed << ',' << (r->done ? 1 : 0) << ',' << r->rows() << ','
-                   << r->col("env_steps").back() << ',' << s.wall << ',' << s.auc << ',' << s.final_return << ','
-                   << s.final_eval << '\n';
-        }
-
-      // The verdict against each baseline.
-      size_t most_seeds = 0;
-      for (const auto& [m, runs] : used) most_seeds = std::max(most_seeds, runs.size());
-      verdict << "## " << task << "\n\nBudget " << millions(budget) << " env steps per run"
-              << (all_done ? "" : " (unfinished runs included: not every method has a finished run)") << ".\n\n";
-      verdict << "| method | seeds | mean return over budget (median) | final return (median) | final eval return "
-                 "(median) | wall time (median) |\n|---|---|---|---|---|---|\n";
-      for (const auto& m : methods) {
-        std::vector<double> auc, fin, ev, wall;
-        for (const auto& s : summaries[m]) {
-          auc.push_back(s.auc);
-          fin.push_back(s.final_return);
-          if (!std::isnan(s.final_eval)) ev.push_back(s.final_eval);
-          wall.push_back(s.wall);
-        }
-        verdict << "| " << m << " | " << used[m].size() << " | " << fmt(stats::median(auc)) << " | "
-                << fmt(stats::median(fin)) << " | " << fmt(stats::median(ev)) << " | "
-                << fmt(stats::median(wall) / 60.0) << " min |\n";
-      }
-      verdict << "\n";
-      if (by_method.count(reference)) {
-        verdict << "| baseline | " << reference << " - baseline: mean return over budget [95%] | " << reference
-                << " - baseline: final eval return [95%] | " << reference
-                << " reaches the baseline's final return at | verdict |\n|---|---|---|---|---|\n";
-        for (const auto& base : methods) {
-          if (base == reference) continue;
-          auto pick = [&](const std::string& m, double Summary::*f) {
-            std::vector<double> v;
-            for (const auto& s : summaries[m])
-              if (!std::isnan(s.*f)) v.push_back(s.*f);
-            return v;
-          };
-          Rng rng(12345);
-          const auto a_auc = pick(reference, &Summary::auc), b_auc = pick(base, &Summary::auc);
-          const auto a_ev = pick(reference, &Summary::final_eval), b_ev = pick(base, &Summary::final_eval);
-          if (a_auc.empty() || b_auc.empty()) {  // no episode ended within the budget
-            verdict << "| " << base << " | n/a | n/a | n/a | no finished episodes to compare |\n";
-            continue;
-          }
-          const auto auc = stats::bootstrapMeanDifference(a_auc, b_auc, resamples, 0.95, rng);
-          std::string ev_text = "n/a";
-          stats::Interval ev{kNaN, kNaN, kNaN};
-          if (!a_ev.empty() && !b_ev.empty()) {
-            ev = stats::bootstrapMeanDifference(a_ev, b_ev, resamples, 0.95, rng);
-            ev_text = fmt(ev.estimate) + " [" + fmt(ev.low) + ", " + fmt(ev.high) + "]";
-          }
-          const double level = stats::median(pick(base, &Summary::final_return));
-          const Band& rb = return_band[reference];
-          const double reach = stats::firstCrossing(rb.steps, rb.median, level);
-          std::string reach_text = std::isnan(reach) ? "not within the budget (" + fmt(level) + ")"
-                                                     : millions(reach) + " (" + fmt(100.0 * reach / budget, 0) +
-                                                           "% of the budget; level " + fmt(level) + ")";
-          const size_t n = std::min(a_auc.size(), b_auc.size());
-          std::string call;
-          auto side = [&](const stats::Interval& iv) {
-            return iv.low > 0 ? 1 : iv.high < 0 ? -1 : 0;
-          };
-          if (n < 3) {
-            call = "too few seeds (" + std::to_string(n) + ") to tell";
-          } else {
-            const int s_auc = side(auc), s_ev = std::isnan(ev.low) ? 0 : side(ev);
-            if (s_auc > 0 && s_ev >= 0) call = reference + " ahead (learns faster" + (s_ev > 0 ? ", ends higher)" : ")");
-            else if (s_auc < 0 && s_ev <= 0) call = base + " ahead (" + reference + "'s ordering does not hold)";
-            else if (s_auc == 0 && s_ev == 0) call = "cannot tell at this budget";
-            else if (s_auc == 0) call = (s_ev > 0 ? reference : base) + " ends higher; learning speed cannot be told apart";
-            else call = "mixed: " + std::string(s_auc > 0 ? reference : base) + " learns faster, " +
-                        (s_ev > 0 ? reference : base) + " ends higher";
-          }
-          verdict << "| " << base << " | " << fmt(auc.estimate) << " [" << fmt(auc.low) << ", " << fmt(auc.high)
-                  << "] | " << ev_text << " | " << reach_text << " | " << call << " |\n";
-        }
-        verdict << "\n";
-      }
-
-      for (auto& ms : milestones) {
-        if (!ms.task.empty() && ms.task != task) continue;
-        if (!any.columns.count(ms.column)) {
-          if (!ms.task.empty()) ms.unmatched = task + "'s metrics.csv has no column '" + ms.column + "'";
-          continue;
-        }
-        ms.matched = true;
-        verdict << "Milestone " << ms.column << " >= " << shortest(ms.level)
-                << ": the env steps of the first row at which it holds (an evaluation figure is known only "
-                << "at the evaluations); a seed that never reaches it within the budget counts as later than "
-                << "any that does.\n\n| method | seeds that reach it | per seed | median | " << reference
-                << " - method: steps [95%] |\n|---|---|---|---|---|\n";
-        std::map<std::string, std::vector<double>> reached;  // NaN: not within the budget
-        for (const auto& m : methods)
-          for (const Run* r : used[m])
-            reached[m].push_back(stats::firstReached(r->col("env_steps"), r->col(ms.column), ms.level, budget));
-        auto allReached = [](const std::vector<double>& v) {
-          return std::none_of(v.begin(), v.end(), [](double x) { return std::isnan(x); });
-        };
-        for (const auto& m : methods) {
-          const auto& v = reached[m];
-          std::vector<double> sorted;  // a run that never reached it is beyond any that did
-          std::string per_seed;
-          int count = 0;
-          for (size_t i = 0; i < v.size(); ++i) {
-            count += !std::isnan(v[i]);
-            sorted.push_back(std::isnan(v[i]) ? std::numeric_limits<double>::infinity() : v[i]);
-            per_seed += (i ? ", s" : "s") + std::to_string(used[m][i]->seed) + " " + steps(v[i]);
-          }
-          // The median by hand: interpolating towards "never" (infinity) would give NaN.
-          std::sort(sorted.begin(), sorted.end());
-          const size_t n = sorted.size();
-          const double med = n == 0       ? std::numeric_limits<double>::infinity()
-                             : n % 2 ? sorted[n / 2]
-                                     : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-          std::string diff;
-          if (m != reference && reached.count(reference)) {
-            const auto& a = reached[reference];
-            if (allReached(a) && allReached(v) && !a.empty() && !v.empty()) {
-              Rng rng(12345);
-              const auto iv = stats::bootstrapMeanDifference(a, v, resamples, 0.95, rng);
-              diff = steps(iv.estimate) + " [" + steps(iv.low) + ", " + steps(iv.high) + "]";
-            } else {
-              diff = "n/a (a seed never reached it)";
-            }
-          }
-          verdict << "| " << m << " | " << count << " of " << v.size() << " | " << per_seed << " | "
-                  << (std::isinf(med) ? "not within the budget" : steps(med)) << " | " << diff << " |\n";
-        }
-        verdict << "\n";
-      }
-
-      // The task's figure: training return, evaluation figures against steps; return against time.
-      const size_t panels = metrics.size() + 1;
-      const int cols = panels > 2 ? 2 : static_cast<int>(panels);
-      const int rows_ = static_cast<int>((panels + cols - 1) / cols);
-      std::ofstream gp(dir / task / "compare.gp");
-      gp << "# " << task << ": median and 25-75% band over seeds. Redraw here with: gnuplot compare.gp\n"
-         << "set terminal pngcairo size " << 700 * cols << "," << 450 * rows_ << " font ',10'\n"
-         << "set output 'compare.png.tmp'\nset termoption noenhanced\n"
-         << "set style fill transparent solid 0.2 noborder\nset grid\nset key bottom right\n"
-         << "set multiplot layout " << rows_ << "," << cols << " title '" << task << ": median and 25-75% over "
-         << most_seeds << " seeds per method'\n";
-      bool keys = true;
-      for (const auto& metric : metrics) {
-        gp << "set title '" << metric.label << "'\nset xlabel 'env steps (millions)'\n"
-           << panel("", metric.column, methods, false, keys);
-        keys = false;
-      }
-      gp << "set title 'training return against wall-clock time (one core per run)'\nset xlabel 'minutes'\n"
-         << panel("", "return", methods, true, false);
-      gp << "unset multiplot\nset output\nsystem('mv -f compare.png.tmp compare.png')\n";
-      gp.close();
-      drawn.push_back({task, methods, metrics});
-      std::printf("masa_compare: %s: %zu methods, up to %zu seeds, budget %s steps -> %s\n", task.c_str(),
-                  methods.size(), most_seeds, millions(budget).c_str(), (dir / task / "compare.png").c_str());
-    }
+    for (const auto& task : task_names)
+      if (auto drawn_task = compareTask(dir, task, reference, resamples, milestones, verdict))
+        drawn.push_back(std::move(*drawn_task));
     if (drawn.empty()) throw std::runtime_error(dir_arg + ": no runs (<task>/<method>_s<seed>/metrics.csv) found");
     for (auto& ms : milestones) {
       if (ms.matched) continue;
