@@ -175,6 +175,13 @@ TEST(ActorEnvironmentsFile, ABitFlippedAtAnyByteOrRandomDamageIsRefusedAndChange
     ASSERT_NE(resumeError(bad, loader.actor), "") << "mutation " << i << " (" << mut.what << ") was accepted";
   }
   EXPECT_EQ(loader.nextObservations(), untouched.nextObservations()) << "a refused file changed the environments";
+  // A file from before the seal (the seal's content alone) resumes, with a warning naming it.
+  const std::string old = (dir / "old_actor_state.bin").string();
+  spit(old, bytes.substr(52 + 4 + actor::kEnvironmentsFileKind.name.size()));
+  ActorUnderTest old_loader(rc, 2);
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(resumeError(old, old_loader.actor), "");
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find("warning: " + old + ": written before masa sealed its files"), std::string::npos);
   ASSERT_EQ(resumeError(good, loader.actor), "");
   EXPECT_EQ(loader.nextObservations(), saver.nextObservations()) << "the intact file resumes exactly";
   std::filesystem::remove_all(dir);

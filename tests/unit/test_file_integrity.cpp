@@ -60,6 +60,13 @@ std::string refusal(const Load& load, const fs::path& path) {
   return "";
 }
 
+// Keeps stderr (the readers' warnings) off the test's output; released on every way out, a failed
+// assertion's too, so that the next test can capture again.
+struct QuietStderr {
+  QuietStderr() { ::testing::internal::CaptureStderr(); }
+  ~QuietStderr() { ::testing::internal::GetCapturedStderr(); }
+};
+
 config::RunConfig smallConfig(const std::string& method) {
   return config::loadRunConfig(config::defaultConfigsDir(), {"task=a1_beam", "method=" + method, "model.policy_hidden=[16]",
                                                              "model.critic_hidden=[16]"});
@@ -103,7 +110,7 @@ TEST(PolicyFileIntegrity, ABitFlippedInTheShippedA1PolicyIsRefused) {
   const fs::path bad = scratchDir("shipped") / "policy.bin";
   const auto load = [](const std::string& p) { policy::loadPolicyFile(p); };
   ::testing::internal::CaptureStderr();
-  ASSERT_EQ(refusal(load, shipped), "");
+  EXPECT_EQ(refusal(load, shipped), "");
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << "the shipped policy is sealed: no warning";
   int checked = 0;
   spit(bad, bytes);
@@ -261,12 +268,13 @@ TEST(DatasetLogIntegrity, ABitFlippedAtAnyByteNeverGetsADamagedEpisodeAccepted) 
   const auto eps = writeToyLog(dir / "toy.lcmlog");
   dataset::LogReadReport report;
   ::testing::internal::CaptureStderr();
-  ASSERT_EQ(dataset::readDatasetLogs({(dir / "toy.lcmlog").string()}, &report).episodes.size(), 3u);
+  EXPECT_EQ(dataset::readDatasetLogs({(dir / "toy.lcmlog").string()}, &report).episodes.size(), 3u);
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << "a sealed log: no warning";
   EXPECT_EQ(report.rejectedTotal(), 0) << report.summary();
   const std::string bytes = slurp(dir / "toy.lcmlog");
   int whole = 0;
-  ::testing::internal::CaptureStderr();
+  {
+  QuietStderr quiet;
   spit(dir / "damaged.lcmlog", bytes);
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     fuzz::flipBitInFile((dir / "damaged.lcmlog").string(), i);
@@ -274,7 +282,7 @@ TEST(DatasetLogIntegrity, ABitFlippedAtAnyByteNeverGetsADamagedEpisodeAccepted) 
     ASSERT_EQ(wrong, "") << "byte " << i << " of " << bytes.size() << " flipped: " << wrong;
     fuzz::flipBitInFile((dir / "damaged.lcmlog").string(), i);
   }
-  ::testing::internal::GetCapturedStderr();
+  }
   // A damaged episode costs itself only: one flipped in the second episode's data leaves two.
   std::string second = bytes;
   const std::size_t at = bytes.size() / 2;
@@ -292,14 +300,13 @@ TEST(DatasetLogIntegrity, RandomMutationsNeverCrashTheReaderNorGetADamagedEpisod
   const auto eps = writeToyLog(dir / "toy.lcmlog");
   const std::string bytes = slurp(dir / "toy.lcmlog");
   std::mt19937_64 rng(35);
-  ::testing::internal::CaptureStderr();
+  QuietStderr quiet;
   for (int i = 0; i < 300; ++i) {
     const fuzz::FileMutation mut = fuzz::mutateFile(bytes, rng);
     spit(dir / "mutated.lcmlog", mut.bytes);
     const std::string wrong = acceptedDamage(dir / "mutated.lcmlog", eps);
     ASSERT_EQ(wrong, "") << "mutation " << i << " (" << mut.what << "): " << wrong;
   }
-  ::testing::internal::GetCapturedStderr();
 }
 
 TEST(DatasetLogIntegrity, ALogWithoutSealsIsReadWithAWarningNamingIt) {
@@ -345,7 +352,7 @@ TEST(Hdf5ExportIntegrity, FlippedBitsAndRandomDamageNeverGetADifferentDatasetAcc
   const dataset::TransitionDataset d = dataset::readDatasetLogs({(dir / "toy.lcmlog").string()});
   dataset::writeHdf5((dir / "toy.h5").string(), d, "toy.lcmlog");
   ::testing::internal::CaptureStderr();
-  ASSERT_EQ(dataset::readHdf5((dir / "toy.h5").string()).rewards, d.rewards) << "the intact export reads back";
+  EXPECT_EQ(dataset::readHdf5((dir / "toy.h5").string()).rewards, d.rewards) << "the intact export reads back";
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << "a sealed export: no warning";
   const std::string bytes = slurp(dir / "toy.h5");
   spit(dir / "damaged.h5", bytes);
