@@ -124,8 +124,9 @@ int main(int argc, char** argv) {
   app.add_option("--trusted-keys", trusted_keys_path, "Ed25519 public key file (PEM), or a directory of *.pub files")
       ->check(CLI::ExistingPath);
   CLI11_PARSE(app, argc, argv);
-  if (require_signed && trusted_keys_path.empty()) {
-    std::fprintf(stderr, "masa_deploy: --require-signed needs --trusted-keys (the public keys a policy may be signed by)\n");
+  if (require_signed != !trusted_keys_path.empty()) {
+    std::fprintf(stderr, require_signed ? "masa_deploy: --require-signed needs --trusted-keys (the public keys a policy may be signed by)\n"
+                                        : "masa_deploy: --trusted-keys is used with --require-signed (say both)\n");
     return 2;
   }
   std::signal(SIGINT, onSignal);

@@ -43,6 +43,10 @@ grep -q '^| return' "$work/intact.log" || fail "no evaluation table: $(cat "$wor
 [ "$(grep '^|' "$work/old.log")" = "$(grep '^|' "$work/intact.log")" ] ||
   fail "unsealed and sealed evaluate differently: $(grep '^| return' "$work/old.log" "$work/intact.log")"
 echo "unsealed: evaluated with a warning, to the sealed file's numbers"
+cp "$work/old.bin" "$work/resealed.bin"
+"$seal" add "$work/resealed.bin" > "$work/add.log" 2>&1 || fail "masa_seal add: $(cat "$work/add.log")"
+cmp -s "$work/resealed.bin" "$policy" || fail "masa_seal add did not give back the shipped file byte for byte"
+echo "masa_seal add: the unsealed copy sealed again is the shipped file byte for byte"
 
 "$seal" keygen --private "$work/release.key" --public "$work/release.pub" > "$work/seal.log" 2>&1 || fail "keygen: $(cat "$work/seal.log")"
 "$seal" keygen --private "$work/other.key" --public "$work/other.pub" >> "$work/seal.log" 2>&1 || fail "keygen: $(cat "$work/seal.log")"
