@@ -2,7 +2,6 @@
 
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -28,25 +27,23 @@ T readPod(std::istream& is, const std::string& path) {
 
 void writeCheckpoint(const std::string& path, const CheckpointState& s, const model::ActorCritic<float>& model,
                      const nn::Adam<float>& adam) {
-  {
-    std::ostringstream os(std::ios::binary);
-    os.write(kMagic, sizeof kMagic);
-    writePod(os, s.run_id);
-    writePod(os, s.updates);
-    writePod(os, s.version);
-    writePod(os, s.env_steps);
-    writePod(os, s.wall_time_s);
-    writePod(os, s.lr);
-    writePod(os, static_cast<uint64_t>(s.rng_state.size()));
-    writeArray(os, s.rng_state.data(), s.rng_state.size());
-    writePod(os, static_cast<uint64_t>(s.order.size()));
-    writeArray(os, s.order.data(), s.order.size());
-    model.save(os);
-    adam.save(os);
-    if (!os) throw std::runtime_error("checkpoint: cannot serialize " + path);
-    // Atomic: a crash leaves the old or the new checkpoint, never half of one.
-    integrity::writeSealedFile(path, kCheckpointFileKind, os.view());
-  }
+  std::ostringstream os(std::ios::binary);
+  os.write(kMagic, sizeof kMagic);
+  writePod(os, s.run_id);
+  writePod(os, s.updates);
+  writePod(os, s.version);
+  writePod(os, s.env_steps);
+  writePod(os, s.wall_time_s);
+  writePod(os, s.lr);
+  writePod(os, static_cast<uint64_t>(s.rng_state.size()));
+  writeArray(os, s.rng_state.data(), s.rng_state.size());
+  writePod(os, static_cast<uint64_t>(s.order.size()));
+  writeArray(os, s.order.data(), s.order.size());
+  model.save(os);
+  adam.save(os);
+  if (!os) throw std::runtime_error("checkpoint: cannot serialize " + path);
+  // Atomic: a crash leaves the old or the new checkpoint, never half of one.
+  integrity::writeSealedFile(path, kCheckpointFileKind, os.view());
 }
 
 bool isCheckpointFile(const std::string& path) { return integrity::looksLikeKind(path, kCheckpointFileKind); }
