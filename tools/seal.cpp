@@ -63,7 +63,9 @@ int add(const std::vector<std::string>& files) {
     const integrity::FileKind* kind = kindOf(f);
     if (!kind) throw std::runtime_error(f + ": not a masa policy, checkpoint or actor environments file");
     // A policy is loaded first, so that a damaged old file is not certified intact.
-    if (kind->name == policy::kPolicyFileKind.name) (void)policy::loadPolicyFile(f);
+    integrity::ReadRules quiet;
+    quiet.warn_unsealed = false;  // (sealing it is the answer to the warning)
+    if (kind->name == policy::kPolicyFileKind.name) (void)policy::loadPolicyFile(f, config::defaultConfigsDir(), quiet);
     std::ifstream in(f, std::ios::binary);
     const std::string payload((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     integrity::writeSealedFile(f, *kind, payload);

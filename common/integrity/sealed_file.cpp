@@ -160,8 +160,9 @@ OpenedFile openSealedBytes(std::string bytes, const std::string& name, const Fil
       refuse(name, "not a " + std::string(kind.name) + " file (no seal, and not the format's own start)");
     if (rules.require_signed_by)
       refuse(name, "not signed (written before masa sealed its files; masa_seal add, then masa_seal sign)");
-    std::fprintf(stderr, "masa: warning: %s: written before masa sealed its files, so no checksum proves it intact (masa_seal add %s seals it)\n",
-                 name.c_str(), name.c_str());
+    if (rules.warn_unsealed)
+      std::fprintf(stderr, "masa: warning: %s: written before masa sealed its files, so no checksum proves it intact (masa_seal add %s seals it)\n",
+                   name.c_str(), name.c_str());
     out.payload = std::move(bytes);
     return out;
   }

@@ -33,6 +33,7 @@ struct FileKind {
 // What a reader requires beyond an intact file.
 struct ReadRules {
   const TrustedKeys* require_signed_by = nullptr;  // refuse a file not signed by one of these keys
+  bool warn_unsealed = true;                       // the one-line warning for a file from before the seal
 };
 
 struct OpenedFile {
