@@ -2,7 +2,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -20,19 +19,15 @@ void EnvironmentsSnapshot::take(const Actor& actor, int64_t update) {
 
 void EnvironmentsSnapshot::writeIfAt(int64_t update, const std::string& path) const {
   if (update != update_) return;  // (the learner's checkpoint and the actor would not agree)
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << kHeader << "\n" << update_ << "\n";
-    out.write(bytes_.data(), static_cast<std::streamsize>(bytes_.size()));
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-  }
-  std::filesystem::rename(tmp, path);
+  std::ostringstream out(std::ios::binary);
+  out << kHeader << "\n" << update_ << "\n";
+  out.write(bytes_.data(), static_cast<std::streamsize>(bytes_.size()));
+  integrity::writeSealedFile(path, kEnvironmentsFileKind, out.view());
 }
 
 std::string resumeEnvironments(const std::string& path, int64_t update, Actor& actor) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return "no " + std::filesystem::path(path).filename().string();
+  if (!std::filesystem::exists(path)) return "no " + std::filesystem::path(path).filename().string();
+  std::istringstream in(integrity::readSealedFile(path, kEnvironmentsFileKind).payload, std::ios::binary);
   std::string header;
   std::string update_line;
   std::getline(in, header);

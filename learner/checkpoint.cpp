@@ -2,7 +2,7 @@
 
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "common/core/binary_io.hpp"
@@ -27,43 +27,31 @@ T readPod(std::istream& is, const std::string& path) {
 
 void writeCheckpoint(const std::string& path, const CheckpointState& s, const model::ActorCritic<float>& model,
                      const nn::Adam<float>& adam) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-    os.write(kMagic, sizeof kMagic);
-    writePod(os, s.run_id);
-    writePod(os, s.updates);
-    writePod(os, s.version);
-    writePod(os, s.env_steps);
-    writePod(os, s.wall_time_s);
-    writePod(os, s.lr);
-    writePod(os, static_cast<uint64_t>(s.rng_state.size()));
-    writeArray(os, s.rng_state.data(), s.rng_state.size());
-    writePod(os, static_cast<uint64_t>(s.order.size()));
-    writeArray(os, s.order.data(), s.order.size());
-    model.save(os);
-    adam.save(os);
-    os.flush();
-    if (!os) throw std::runtime_error("checkpoint: cannot write " + tmp);
-  }
-  fs::rename(tmp, path);  // atomic on POSIX: a crash leaves the old or the new checkpoint, never half
+  std::ostringstream os(std::ios::binary);
+  os.write(kMagic, sizeof kMagic);
+  writePod(os, s.run_id);
+  writePod(os, s.updates);
+  writePod(os, s.version);
+  writePod(os, s.env_steps);
+  writePod(os, s.wall_time_s);
+  writePod(os, s.lr);
+  writePod(os, static_cast<uint64_t>(s.rng_state.size()));
+  writeArray(os, s.rng_state.data(), s.rng_state.size());
+  writePod(os, static_cast<uint64_t>(s.order.size()));
+  writeArray(os, s.order.data(), s.order.size());
+  model.save(os);
+  adam.save(os);
+  if (!os) throw std::runtime_error("checkpoint: cannot serialize " + path);
+  // Atomic: a crash leaves the old or the new checkpoint, never half of one.
+  integrity::writeSealedFile(path, kCheckpointFileKind, os.view());
 }
 
-bool isCheckpointFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[sizeof kMagic] = {};
-  in.read(magic, sizeof magic);
-  return in && std::memcmp(magic, kMagic, sizeof magic) == 0;
-}
+bool isCheckpointFile(const std::string& path) { return integrity::looksLikeKind(path, kCheckpointFileKind); }
 
-CheckpointState readCheckpoint(const std::string& path, model::ActorCritic<float>& model, nn::Adam<float>* adam) {
-  std::ifstream is(path, std::ios::binary);
-  if (!is) throw std::runtime_error(path + ": cannot open the checkpoint");
-  return readCheckpoint(is, path, model, adam);
-}
+namespace {
 
-CheckpointState readCheckpoint(std::istream& is, const std::string& path, model::ActorCritic<float>& model,
-                               nn::Adam<float>* adam) {
+CheckpointState parseCheckpoint(std::istream& is, const std::string& path, model::ActorCritic<float>& model,
+                                nn::Adam<float>* adam) {
   char magic[sizeof kMagic];
   is.read(magic, sizeof magic);
   if (!is || std::memcmp(magic, kMagic, sizeof magic) != 0)
@@ -84,8 +72,27 @@ CheckpointState readCheckpoint(std::istream& is, const std::string& path, model:
   s.order.resize(on);
   if (!io::readArray(is, s.order.data(), on)) throw std::runtime_error(path + ": truncated checkpoint");
   model.load(is, path);
-  if (adam) adam->load(is);
+  if (adam) {
+    adam->load(is);
+    if (is.peek() != std::char_traits<char>::eof()) throw std::runtime_error(path + ": bytes after the optimizer (corrupt checkpoint)");
+  }
   return s;
+}
+
+}  // namespace
+
+CheckpointState readCheckpointBytes(std::string bytes, const std::string& name, model::ActorCritic<float>& model,
+                                    nn::Adam<float>* adam) {
+  const integrity::OpenedFile file = integrity::openSealedBytes(std::move(bytes), name, kCheckpointFileKind);
+  std::istringstream is(file.payload, std::ios::binary);
+  return parseCheckpoint(is, name, model, adam);
+}
+
+CheckpointState readCheckpoint(const std::string& path, model::ActorCritic<float>& model, nn::Adam<float>* adam) {
+  if (!fs::exists(path)) throw std::runtime_error(path + ": cannot open the checkpoint (no such file)");
+  const integrity::OpenedFile file = integrity::readSealedFile(path, kCheckpointFileKind);
+  std::istringstream is(file.payload, std::ios::binary);
+  return parseCheckpoint(is, path, model, adam);
 }
 
 }  // namespace masa::learner

@@ -2,8 +2,9 @@
 // (counters, lr, random state, minibatch shuffle, model with normalizers, Adam moments). The
 // model part is the same as a policy file's, so a checkpoint can also be evaluated directly.
 //
-// Layout: "MASACKP1", run id, update count, version, env steps, wall time, lr, rng state text,
-// shuffle order, ActorCritic::save(), Adam::save(). Written atomically (tmp + rename).
+// Layout: sealed (common/integrity/sealed_file.hpp: SHA-256 checked before any byte is used), and
+// inside the seal "MASACKP1", run id, update count, version, env steps, wall time, lr, rng state
+// text, shuffle order, ActorCritic::save(), Adam::save(). Written atomically (tmp + rename).
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/integrity/sealed_file.hpp"
 #include "common/model/actor_critic.hpp"
 #include "common/nn/adam.hpp"
 
@@ -27,16 +29,18 @@ struct CheckpointState {
   std::vector<int> order;  // the PPO minibatch shuffle
 };
 
+inline constexpr integrity::FileKind kCheckpointFileKind{"masa learner checkpoint", "MASACKP1"};
+
 void writeCheckpoint(const std::string& path, const CheckpointState& state, const model::ActorCritic<float>& model,
                      const nn::Adam<float>& adam);
 
 // Reads the state and loads the model; loads the optimizer too unless `adam` is null (evaluation).
 // Throws std::runtime_error naming the file and what is wrong.
 CheckpointState readCheckpoint(const std::string& path, model::ActorCritic<float>& model, nn::Adam<float>* adam);
-// The same from a checkpoint's bytes in a stream (data-parallel ranks get rank 0's file this way);
-// `name` says where they came from in errors.
-CheckpointState readCheckpoint(std::istream& is, const std::string& name, model::ActorCritic<float>& model,
-                               nn::Adam<float>* adam);
+// The same from a checkpoint file's bytes (data-parallel ranks get rank 0's file this way); `name`
+// says where they came from in errors.
+CheckpointState readCheckpointBytes(std::string bytes, const std::string& name, model::ActorCritic<float>& model,
+                                    nn::Adam<float>* adam);
 
 bool isCheckpointFile(const std::string& path);
 

@@ -378,8 +378,7 @@ void Learner::loadCheckpoint() {
       bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     ranks_->broadcast(bytes, 0);
-    std::istringstream in(std::string(bytes.begin(), bytes.end()), std::ios::binary);
-    s = readCheckpoint(in, path + " (rank 0's)", *model_, adam_.get());
+    s = readCheckpointBytes(std::string(bytes.begin(), bytes.end()), path + " (rank 0's)", *model_, adam_.get());
   }
   if (run_id_ == 0) run_id_ = s.run_id;  // keep the run: its actors go on being accepted
   if (s.version != s.updates)

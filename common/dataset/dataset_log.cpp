@@ -10,6 +10,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "common/dataset/log_seal.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/transport.hpp"
 #include "common/transport/wire_guard.hpp"
@@ -181,16 +182,20 @@ class EpisodeAssembler {
   std::unordered_set<int64_t> complete_;
 };
 
-// Walks one log's events; a damaged or truncated tail ends the file with a note.
+// Walks one log's events; a damaged or truncated tail ends the file with a note. Events go to the
+// episodes only once the seal after them checks (log_seal.hpp); a log without any seal is read as
+// lcm-logger recorded it, with a warning.
 void readLogFile(const std::string& path, EpisodeAssembler& episodes, LogReadReport& report) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw std::runtime_error("cannot open dataset log " + path + ": " + std::strerror(errno));
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> closer(f, &std::fclose);
   std::error_code ec;
   const int64_t file_size = static_cast<int64_t>(std::filesystem::file_size(path, ec));
-  int64_t pos = 0, events = 0;
+  int64_t pos = 0, events = 0, seals = 0;
   std::vector<unsigned char> buf;
   std::string channel;
+  LogSealChain chain;
+  std::vector<std::string> unsealed;  // the dataset's messages since the last seal
   auto stop = [&](const std::string& what) {
     report.notes.push_back(path + ": " + what + " at byte " + std::to_string(pos) + " after " +
                            std::to_string(events) + " event(s); the rest of the file is skipped");
@@ -230,11 +235,34 @@ void readLogFile(const std::string& path, EpisodeAssembler& episodes, LogReadRep
     pos += 28 + body;
     ++events;
     ++report.events;
+    const std::string_view data(reinterpret_cast<const char*>(buf.data()), buf.size());
+    if (isSealEvent(channel, data)) {
+      ++seals;
+      if (chain.verify(data)) {
+        for (const std::string& m : unsealed) episodes.take(m.data(), static_cast<int>(m.size()), path);
+      } else if (!unsealed.empty()) {
+        report.rejected["events whose seal fails (damaged log)"] += static_cast<int64_t>(unsealed.size());
+        report.notes.push_back(path + ": the seal at byte " + std::to_string(pos - 28 - body) + " fails; the " +
+                               std::to_string(unsealed.size()) + " event(s) it seals are left out");
+      }
+      unsealed.clear();
+      continue;
+    }
+    chain.add(channel, data);
     if (channel != transport::kDatasetChannel) {
       ++report.other_channel;
       continue;
     }
-    episodes.take(buf.data(), data_len, path);
+    unsealed.emplace_back(data);
+  }
+  if (seals == 0) {
+    ++report.unsealed_files;
+    report.notes.push_back(path + ": no seal (lcm-logger's recording, or written before masa sealed its logs): events vetted, "
+                                  "but nothing proves them intact");
+    std::fprintf(stderr, "masa: warning: %s: an unsealed dataset log; nothing proves its events intact\n", path.c_str());
+    for (const std::string& m : unsealed) episodes.take(m.data(), static_cast<int>(m.size()), path);
+  } else if (!unsealed.empty()) {
+    report.rejected["unsealed events after the last seal (a recording cut short)"] += static_cast<int64_t>(unsealed.size());
   }
 }
 
@@ -244,6 +272,24 @@ DatasetLogWriter::DatasetLogWriter(const std::string& path, int max_steps_per_me
     : path_(path), max_steps_(max_steps_per_message), log_(std::make_unique<lcm::LogFile>(path, "w")) {
   if (!log_->good()) throw std::runtime_error("cannot create dataset log " + path);
   if (max_steps_ <= 0) throw std::invalid_argument("steps per message must be positive");
+  writeSeal();  // the opening seal: this log is sealed, so a log without seals is not one of ours
+}
+
+void DatasetLogWriter::writeEvent(const char* channel, const unsigned char* data, int32_t size, int64_t utime) {
+  lcm::LogEvent ev;
+  ev.eventnum = 0;
+  ev.timestamp = utime;
+  ev.channel = channel;
+  ev.datalen = size;
+  ev.data = const_cast<unsigned char*>(data);
+  if (log_->writeEvent(&ev) != 0) throw std::runtime_error("writing " + path_ + " failed");
+}
+
+void DatasetLogWriter::writeSeal() {
+  const std::string seal = seals_.seal();
+  writeEvent(transport::kDatasetSealChannel, reinterpret_cast<const unsigned char*>(seal.data()), static_cast<int32_t>(seal.size()),
+             transport::wallClockMicros());
+  std::fflush(log_->getFilePtr());  // a crash loses at most the episode being written
 }
 
 DatasetLogWriter::~DatasetLogWriter() = default;
@@ -253,15 +299,10 @@ void DatasetLogWriter::write(const EpisodeRecord& episode) {
   for (masa::lcmt_transitions& m : episodeMessages(episode, max_steps_, transport::wallClockMicros())) {
     bytes.resize(static_cast<size_t>(m.getEncodedSize()));
     m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-    lcm::LogEvent ev;
-    ev.eventnum = 0;
-    ev.timestamp = m.utime;
-    ev.channel = transport::kDatasetChannel;
-    ev.datalen = static_cast<int32_t>(bytes.size());
-    ev.data = bytes.data();
-    if (log_->writeEvent(&ev) != 0) throw std::runtime_error("writing " + path_ + " failed");
+    writeEvent(transport::kDatasetChannel, bytes.data(), static_cast<int32_t>(bytes.size()), m.utime);
+    seals_.add(transport::kDatasetChannel, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
   }
-  std::fflush(log_->getFilePtr());  // a crash loses at most the episode being written
+  writeSeal();
   ++episodes_;
 }
 
@@ -274,6 +315,7 @@ int64_t LogReadReport::rejectedTotal() const {
 std::string LogReadReport::summary() const {
   std::ostringstream os;
   os << files << " log(s), " << events << " events: " << episodes << " episodes, " << transitions << " transitions";
+  if (unsealed_files > 0) os << "; " << unsealed_files << " log(s) without seals";
   if (other_channel > 0) os << "; " << other_channel << " events of other channels ignored";
   os << "\n";
   for (const auto& [reason, count] : rejected) os << "  refused " << count << ": " << reason << "\n";

@@ -1,5 +1,6 @@
 // Offline datasets as LCM logs: the file format of lcm-logger (and lcm-logplayer, lcm-spy), with
-// the episodes on channel MASA_DATASET as lcmt_transitions messages.
+// the episodes on channel MASA_DATASET as lcmt_transitions messages, and seals on
+// MASA_DATASET_SEAL that prove them intact (log_seal.hpp).
 //
 // The reader parses the log format itself rather than through liblcm's reader, which resyncs
 // silently over damage and cannot tell a truncated last event from the end of the file. Every
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "common/dataset/episode_record.hpp"
+#include "common/dataset/log_seal.hpp"
 #include "common/dataset/transition_dataset.hpp"
 
 namespace lcm {
@@ -23,7 +25,8 @@ class LogFile;
 
 namespace masa::dataset {
 
-// Writes episodes into a new LCM log (as lcm-logger would have recorded them).
+// Writes episodes into a new LCM log (as lcm-logger would have recorded them), each episode
+// followed by a seal; not renamed into place, so that a long recording keeps what it sealed.
 class DatasetLogWriter {
  public:
   // Throws when the file cannot be created.
@@ -33,9 +36,13 @@ class DatasetLogWriter {
   int64_t episodesWritten() const { return episodes_; }
 
  private:
+  void writeEvent(const char* channel, const unsigned char* data, int32_t size, int64_t utime);
+  void writeSeal();
+
   std::string path_;
   int max_steps_;
   std::unique_ptr<lcm::LogFile> log_;
+  LogSealChain seals_;
   int64_t episodes_ = 0;
 };
 
@@ -46,6 +53,7 @@ struct LogReadReport {
   int64_t messages = 0;            // MASA_DATASET messages accepted
   int64_t episodes = 0;            // complete episodes in the dataset
   int64_t transitions = 0;
+  int unsealed_files = 0;          // logs without any seal (read with a warning)
   std::map<std::string, int64_t> rejected;  // reason -> count (messages, or episodes where said)
   std::vector<std::string> notes;           // one line per damaged file, skipped episode kind, ...
 

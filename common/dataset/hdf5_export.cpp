@@ -2,13 +2,67 @@
 
 #include <hdf5.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string_view>
 #include <sstream>
 #include <stdexcept>
 
+#include "common/integrity/sha256.hpp"
+
 namespace masa::dataset {
 namespace {
+
+// The seal: HDF5 skips a file's user block (its first 512 bytes), so masa keeps there the SHA-256 of
+// everything after it: "MASAH5S1" | u64 length of the rest | 32-byte SHA-256 of the rest. masa's
+// reader checks it before HDF5 parses a byte (libhdf5 itself can crash on a damaged file: found by
+// Hdf5ExportIntegrity's fuzzing). h5py and every other HDF5 reader read the file as usual.
+constexpr hsize_t kUserBlockBytes = 512;
+constexpr std::string_view kSealMagic = "MASAH5S1";
+constexpr std::string_view kHdf5Signature = "\x89HDF\r\n\x1a\n";
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open " + path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Writes the seal into the user block of a finished file, flushed to the disk.
+void sealUserBlock(const std::string& path) {
+  const std::string bytes = readAll(path);
+  if (bytes.size() < kUserBlockBytes) throw std::runtime_error(path + ": no user block to seal");
+  const std::string_view rest = std::string_view(bytes).substr(kUserBlockBytes);
+  const integrity::Digest d = integrity::sha256(rest);
+  const uint64_t n = rest.size();
+  std::FILE* f = std::fopen(path.c_str(), "r+b");
+  if (!f) throw std::runtime_error("cannot seal " + path);
+  const bool ok = std::fwrite(kSealMagic.data(), 1, kSealMagic.size(), f) == kSealMagic.size() && std::fwrite(&n, sizeof n, 1, f) == 1 &&
+                  std::fwrite(d.data(), 1, d.size(), f) == d.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
+  if (std::fclose(f) != 0 || !ok) throw std::runtime_error("sealing " + path + " failed");
+}
+
+// Checks the seal of a file's bytes; a file that starts with HDF5's own signature is one exported
+// before the seal (warned about). Throws naming the file and the reason.
+void checkUserBlockSeal(const std::string& bytes, const std::string& path) {
+  if (bytes.compare(0, kHdf5Signature.size(), kHdf5Signature) == 0) {
+    std::fprintf(stderr, "masa: warning: %s: exported before masa sealed its files, so no checksum proves it intact\n", path.c_str());
+    return;
+  }
+  if (bytes.size() < kUserBlockBytes || bytes.compare(0, kSealMagic.size(), kSealMagic) != 0)
+    throw std::runtime_error(path + ": not a masa HDF5 export (no seal, and not HDF5's own start)");
+  uint64_t n = 0;
+  std::memcpy(&n, bytes.data() + kSealMagic.size(), sizeof n);
+  integrity::Digest stored;
+  std::memcpy(stored.data(), bytes.data() + kSealMagic.size() + sizeof n, stored.size());
+  if (n != bytes.size() - kUserBlockBytes || integrity::sha256(std::string_view(bytes).substr(kUserBlockBytes)) != stored)
+    throw std::runtime_error(path + ": checksum mismatch (file corrupted or truncated)");
+}
 
 // HDF5 handles closed on every path out.
 class Handle {
@@ -30,10 +84,19 @@ void check(herr_t status, const std::string& what) {
   if (status < 0) throw std::runtime_error("HDF5: " + what + " failed");
 }
 
+// Chunked with HDF5's Fletcher-32 filter, so that any HDF5 reader (h5py too) refuses a damaged chunk.
 void writeArray(hid_t parent, const char* name, hid_t type, const void* data, hsize_t rows, hsize_t cols) {
   const hsize_t dims[2] = {rows, cols};
-  Handle space(H5Screate_simple(cols > 0 ? 2 : 1, dims, nullptr), H5Sclose, std::string("space of ") + name);
-  Handle set(H5Dcreate2(parent, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose,
+  const int rank = cols > 0 ? 2 : 1;
+  Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose, std::string("space of ") + name);
+  Handle create(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "dataset properties");
+  if (rows > 0) {
+    const hsize_t row_bytes = std::max<hsize_t>(cols, 1) * H5Tget_size(type);
+    const hsize_t chunk[2] = {std::clamp<hsize_t>((hsize_t{1} << 18) / row_bytes, 1, rows), cols};
+    check(H5Pset_chunk(create, rank, chunk), std::string("chunks of ") + name);
+    check(H5Pset_fletcher32(create), std::string("checksum of ") + name);
+  }
+  Handle set(H5Dcreate2(parent, name, type, space, H5P_DEFAULT, create, H5P_DEFAULT), H5Dclose,
              std::string("creating ") + name);
   if (rows > 0) check(H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), std::string("writing ") + name);
 }
@@ -108,7 +171,12 @@ void writeHdf5(const std::string& path, const TransitionDataset& d, const std::s
   d.validate();
   const std::string tmp = path + ".tmp";
   {
-    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose, "creating " + tmp);
+    // HDF5's newer object headers and superblock carry checksums of their own (readable by 1.8 on).
+    Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "file access properties");
+    check(H5Pset_libver_bounds(access, H5F_LIBVER_V18, H5F_LIBVER_LATEST), "file format bounds");
+    Handle create(H5Pcreate(H5P_FILE_CREATE), H5Pclose, "file creation properties");
+    check(H5Pset_userblock(create, kUserBlockBytes), "user block");
+    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, create, access), H5Fclose, "creating " + tmp);
     const hsize_t n = static_cast<hsize_t>(d.size());
     // Column-major obs_dim x N is row-major N x obs_dim: the bytes go as they are.
     writeArray(file, "observations", H5T_NATIVE_FLOAT, d.obs.data(), n, d.obs_dim);
@@ -148,6 +216,7 @@ void writeHdf5(const std::string& path, const TransitionDataset& d, const std::s
     writeStringAttribute(file, "source", source);
     check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush");
   }
+  sealUserBlock(tmp);
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) throw std::runtime_error("cannot move " + tmp + " to " + path + ": " + ec.message());
@@ -156,6 +225,7 @@ void writeHdf5(const std::string& path, const TransitionDataset& d, const std::s
 TransitionDataset readHdf5(const std::string& path) {
   quietHdf5();
   if (!std::filesystem::exists(path)) throw std::runtime_error("no such HDF5 file: " + path);
+  checkUserBlockSeal(readAll(path), path);  // before HDF5 parses a byte of it
   Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "opening " + path);
   TransitionDataset d;
   d.task = readStringAttribute(file, "task");
@@ -188,7 +258,8 @@ TransitionDataset readHdf5(const std::string& path) {
   readArray(eps, "policy", H5T_NATIVE_INT64, policy.data(), m);
   for (hsize_t k = 0; k < m; ++k)
     d.episodes.push_back({id[k], static_cast<int32_t>(policy[k]), start[k], static_cast<int32_t>(length[k]), ret[k], success[k]});
-  std::istringstream names(readStringAttribute(file, "policy_names"));
+  const std::string names_text = readStringAttribute(file, "policy_names");
+  std::istringstream names(names_text);
   for (std::string line; std::getline(names, line);) d.policy_names.push_back(line);
   d.validate();
   return d;

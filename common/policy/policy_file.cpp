@@ -49,31 +49,22 @@ std::string readWholeFile(const std::string& path) {
 
 void savePolicyFile(const std::string& path, const config::RunConfig& rc, const model::ActorCritic<float>& model) {
   const std::string spec_text = readWholeFile(rc.spec_path);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-    if (!os) throw std::runtime_error(tmp + ": cannot write");
-    os.write(kMagic, sizeof kMagic);
-    io::writePod(os, kFormatVersion);
-    writeText(os, config::dumpResolved(rc));
-    writeText(os, spec_text);
-    model.save(os);
-    os.flush();
-    if (!os) throw std::runtime_error(tmp + ": write failed");
-  }
-  fs::rename(tmp, path);
+  std::ostringstream os(std::ios::binary);
+  os.write(kMagic, sizeof kMagic);
+  io::writePod(os, kFormatVersion);
+  writeText(os, config::dumpResolved(rc));
+  writeText(os, spec_text);
+  model.save(os);
+  if (!os) throw std::runtime_error(path + ": cannot serialize the policy");
+  integrity::writeSealedFile(path, kPolicyFileKind, os.view());
 }
 
-bool isPolicyFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[sizeof kMagic] = {};
-  in.read(magic, sizeof magic);
-  return in && std::memcmp(magic, kMagic, sizeof magic) == 0;
-}
+bool isPolicyFile(const std::string& path) { return integrity::looksLikeKind(path, kPolicyFileKind); }
 
-LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_dir) {
-  std::ifstream is(path, std::ios::binary);
-  if (!is) throw std::runtime_error(path + ": cannot open the policy file");
+LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_dir, const integrity::ReadRules& rules) {
+  if (!fs::exists(path)) throw std::runtime_error(path + ": cannot open the policy file (no such file)");
+  const integrity::OpenedFile file = integrity::readSealedFile(path, kPolicyFileKind, rules);
+  std::istringstream is(file.payload, std::ios::binary);
   char magic[sizeof kMagic] = {};
   is.read(magic, sizeof magic);
   if (!is || std::memcmp(magic, kMagic, sizeof magic) != 0)
@@ -84,6 +75,7 @@ LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_
                              std::to_string(kFormatVersion));
   LoadedPolicy p;
   p.source = path;
+  p.integrity = file.describe();
   const std::string config_text = readText(is, path, "config");
   p.spec_text = readText(is, path, "spec");
   try {
@@ -94,6 +86,7 @@ LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_
   }
   p.model = std::make_unique<model::ActorCritic<float>>(p.spec, p.config.model);
   p.model->load(is, path);
+  if (is.peek() != std::char_traits<char>::eof()) throw std::runtime_error(path + ": bytes after the model (corrupt policy file)");
   return p;
 }
 

@@ -3,14 +3,16 @@
 // the symmetry spec's own text (so the file works on a machine whose configs/ differ), and the
 // model (policy and critic networks, observation and value normalizers).
 //
-// Layout: "MASAPOL1", u32 format version, u64 length + config YAML, u64 length + spec YAML,
-// then ActorCritic::save(). Written atomically (tmp + rename).
+// Layout: sealed (common/integrity/sealed_file.hpp: SHA-256, optionally signed), and inside the
+// seal "MASAPOL1", u32 format version, u64 length + config YAML, u64 length + spec YAML, then
+// ActorCritic::save(), nothing after it. Written atomically (tmp + rename).
 #pragma once
 
 #include <memory>
 #include <string>
 
 #include "common/config/run_config.hpp"
+#include "common/integrity/sealed_file.hpp"
 #include "common/model/actor_critic.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 
@@ -21,15 +23,22 @@ struct LoadedPolicy {
   std::string spec_text;
   sym::SymmetrySpec spec;
   std::unique_ptr<model::ActorCritic<float>> model;
-  std::string source;  // the file it came from
+  std::string source;     // the file it came from
+  std::string integrity;  // how the file proved it is intact ("sealed (SHA-256 checked), signed by ...")
 };
+
+// What a policy file is inside its seal.
+inline constexpr integrity::FileKind kPolicyFileKind{"masa policy", "MASAPOL1"};
 
 void savePolicyFile(const std::string& path, const config::RunConfig& rc, const model::ActorCritic<float>& model);
 
-// Reads a policy file; throws std::runtime_error naming the file and what is wrong.
-LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_dir = config::defaultConfigsDir());
+// Reads a policy file; throws std::runtime_error naming the file and what is wrong: a failed
+// checksum or signature, a signature `rules` require and the file lacks, a malformed content.
+LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_dir = config::defaultConfigsDir(),
+                            const integrity::ReadRules& rules = {});
 
-// True when the file starts with the policy file's magic.
+// True when the file is a policy file by its first bytes (sealed as one, or an unsealed one's
+// magic); checks nothing else.
 bool isPolicyFile(const std::string& path);
 
 // The equivariance MASA guarantees, measured on random observations (normalizer, mean, std,

@@ -13,5 +13,7 @@ inline constexpr const char* kRobotStateChannel = "MASA_ROBOT_STATE";      // lc
 inline constexpr const char* kRobotCommandChannel = "MASA_ROBOT_COMMAND";  // lcmt_robot_command
 // Offline datasets: recorded episodes (masa_dataset record).
 inline constexpr const char* kDatasetChannel = "MASA_DATASET";            // lcmt_transitions
+// A dataset log's seals (common/dataset/log_seal.hpp): 48 raw bytes, not an LCM type; only in files.
+inline constexpr const char* kDatasetSealChannel = "MASA_DATASET_SEAL";
 
 }  // namespace masa::transport

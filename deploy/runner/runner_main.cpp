@@ -4,6 +4,8 @@
 // (configs/deploy/defaults.yaml). Refuses to start while another runner publishes commands; then
 // ramps to the nominal pose, hands over to the policy, and keeps the watchdog and the limits
 // (deploy/runner/policy_runner.hpp). Ctrl-C publishes the safe command before it exits.
+// --require-signed --trusted-keys KEYS refuses a policy file not signed by one of the Ed25519 public
+// keys in KEYS (a .pub file, or a directory of them; masa_seal keygen / sign make them).
 // Exit codes: 0 stopped (signal, --duration, --max-policy-steps), 2 error, 3 start guard refused or
 // another runner appeared, 4 stopped by the watchdog or the emergency stop (--exit-on-trip).
 #include <CLI/CLI.hpp>
@@ -107,7 +109,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   double duration_s = 0;
   int64_t max_policy_steps = 0;
-  bool quiet = false, exit_on_trip = false;
+  bool quiet = false, exit_on_trip = false, require_signed = false;
+  std::string trusted_keys_path;
   app.add_option("policy", policy_path, "policy file (policy.bin of a run, or a shipped one)")->required()
       ->check(CLI::ExistingFile);
   app.add_option("--config", config_file, "the robot's deploy config (YAML; keys of configs/deploy/defaults.yaml)");
@@ -117,13 +120,28 @@ int main(int argc, char** argv) {
   app.add_option("--max-policy-steps", max_policy_steps, "hold the pose and stop after this many policy commands");
   app.add_flag("--exit-on-trip", exit_on_trip, "exit (code 4) once the watchdog or the emergency stop has tripped and its command is out");
   app.add_flag("--quiet", quiet, "no per-second status line");
+  app.add_flag("--require-signed", require_signed, "refuse a policy file not signed by a key of --trusted-keys");
+  app.add_option("--trusted-keys", trusted_keys_path, "Ed25519 public key file (PEM), or a directory of *.pub files")
+      ->check(CLI::ExistingPath);
   CLI11_PARSE(app, argc, argv);
+  if (require_signed != !trusted_keys_path.empty()) {
+    std::fprintf(stderr, require_signed ? "masa_deploy: --require-signed needs --trusted-keys (the public keys a policy may be signed by)\n"
+                                        : "masa_deploy: --trusted-keys is used with --require-signed (say both)\n");
+    return 2;
+  }
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
 
   try {
     const deploy::DeployConfig cfg = deploy::loadDeployConfig(config_file, sets);
-    policy::LoadedPolicy lp = policy::loadPolicyFile(policy_path);
+    integrity::TrustedKeys trusted;
+    integrity::ReadRules rules;
+    if (require_signed) {
+      trusted = integrity::TrustedKeys::load(trusted_keys_path);
+      rules.require_signed_by = &trusted;
+    }
+    policy::LoadedPolicy lp = policy::loadPolicyFile(policy_path, config::defaultConfigsDir(), rules);
+    std::fprintf(stderr, "masa_deploy: %s: %s\n", policy_path.c_str(), lp.integrity.c_str());
     const double sym_error = policy::checkPolicySymmetry(lp);
     std::random_device rd;
     const int64_t runner_id = static_cast<int64_t>((uint64_t{rd()} << 32) ^ rd() ^ steadyMicros()) & INT64_MAX;

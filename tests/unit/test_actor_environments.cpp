@@ -1,19 +1,27 @@
 // An actor's environments saved between rollouts and loaded into another actor of the same run:
 // the loaded actor's next rollout is the saver's, bit for bit; a file that does not fit (cut short
 // anywhere, another task, another number of environments, a foreign tag, bytes after the end) is
-// refused by name and changes nothing.
+// refused by name and changes nothing. The file they are written to (actor_state.bin) is sealed:
+// a bit flipped at any byte, or random damage of any kind, is refused and changes nothing.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "actors/actor.hpp"
+#include "actors/environments_snapshot.hpp"
 #include "common/config/run_config.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/transport.hpp"
+#include "file_mutations.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
 namespace masa {
@@ -121,6 +129,62 @@ TEST(ActorEnvironments, AFileThatDoesNotFitIsRefusedByNameAndChangesNothing) {
             std::string::npos);
 
   EXPECT_EQ(loader.nextObservations(), untouched.nextObservations()) << "a refused file changed the environments";
+}
+
+std::string slurp(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void spit(const std::string& p, const std::string& bytes) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::string resumeError(const std::string& path, actor::Actor& actor) {
+  try {
+    return actor::resumeEnvironments(path, 1, actor);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+}
+
+TEST(ActorEnvironmentsFile, ABitFlippedAtAnyByteOrRandomDamageIsRefusedAndChangesNothing) {
+  const auto rc = smallConfig("a1_beam");
+  ActorUnderTest saver(rc, 2), loader(rc, 2), untouched(rc, 2);
+  saver.nextObservations();
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("masa_actor_state_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string good = (dir / "actor_state.bin").string(), bad = (dir / "damaged.bin").string();
+  actor::EnvironmentsSnapshot snapshot;
+  snapshot.take(saver.actor, 1);
+  snapshot.writeIfAt(1, good);
+  const std::string bytes = slurp(good);
+  spit(bad, bytes);
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    fuzz::flipBitInFile(bad, i);
+    const std::string why = resumeError(bad, loader.actor);
+    ASSERT_EQ(why.rfind(bad + ": ", 0), 0u) << "byte " << i << " of " << bytes.size() << " flipped: '" << why << "'";
+    fuzz::flipBitInFile(bad, i);
+  }
+  std::mt19937_64 rng(36);
+  for (int i = 0; i < 300; ++i) {
+    const fuzz::FileMutation mut = fuzz::mutateFile(bytes, rng);
+    if (mut.bytes == bytes) continue;
+    spit(bad, mut.bytes);
+    ASSERT_NE(resumeError(bad, loader.actor), "") << "mutation " << i << " (" << mut.what << ") was accepted";
+  }
+  EXPECT_EQ(loader.nextObservations(), untouched.nextObservations()) << "a refused file changed the environments";
+  // A file from before the seal (the seal's content alone) resumes, with a warning naming it.
+  const std::string old = (dir / "old_actor_state.bin").string();
+  spit(old, bytes.substr(52 + 4 + actor::kEnvironmentsFileKind.name.size()));
+  ActorUnderTest old_loader(rc, 2);
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(resumeError(old, old_loader.actor), "");
+  EXPECT_NE(::testing::internal::GetCapturedStderr().find("warning: " + old + ": written before masa sealed its files"), std::string::npos);
+  ASSERT_EQ(resumeError(good, loader.actor), "");
+  EXPECT_EQ(loader.nextObservations(), saver.nextObservations()) << "the intact file resumes exactly";
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

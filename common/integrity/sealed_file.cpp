@@ -1,0 +1,219 @@
+#include "common/integrity/sealed_file.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+
+#include "common/integrity/sha256.hpp"
+
+namespace masa::integrity {
+namespace {
+
+constexpr std::string_view kSealMagic = "MASASEAL";
+constexpr std::uint32_t kEnvelopeVersion = 1;
+constexpr std::size_t kHeaderBytes = 8 + 4 + 8 + 32;
+constexpr std::string_view kSignatureMagic = "MASASIG1";
+constexpr std::size_t kSignatureBytes = 8 + 32 + 64;
+constexpr std::string_view kSignatureContext = "masa sealed file signature 1\n";
+constexpr std::uint32_t kMaxKindBytes = 64;
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 34;  // 16 GiB: larger is not a masa file
+
+template <class T>
+T podAt(const std::string& bytes, std::size_t offset) {
+  T v;
+  std::memcpy(&v, bytes.data() + offset, sizeof v);
+  return v;
+}
+
+template <class T>
+void appendPod(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+// What the envelope says once every check passed.
+struct Envelope {
+  std::string kind;
+  std::size_t payload_offset = 0, payload_size = 0, body_end = 0;
+  std::optional<PublicKeyBytes> signer;
+};
+
+[[noreturn]] void refuse(const std::string& name, const std::string& why) { throw std::runtime_error(name + ": " + why); }
+
+std::string signedMessage(const std::string& bytes) {
+  return std::string(kSignatureContext).append(bytes, 0, kHeaderBytes);
+}
+
+// Checks the envelope: lengths against the file size, the body's SHA-256, the kind's bounds, and a
+// signature when there is one. Nothing of the body is looked at before its checksum matched.
+Envelope checkEnvelope(const std::string& bytes, const std::string& name) {
+  if (bytes.size() < kHeaderBytes)
+    refuse(name, "truncated (" + std::to_string(bytes.size()) + " bytes, shorter than the seal's header)");
+  const auto version = podAt<std::uint32_t>(bytes, 8);
+  if (version != kEnvelopeVersion)
+    refuse(name, "sealed with envelope version " + std::to_string(version) + ", this masa reads " + std::to_string(kEnvelopeVersion) +
+                     " (a newer masa's file, or a damaged one)");
+  const auto body = podAt<std::uint64_t>(bytes, 12);
+  const std::size_t after_header = bytes.size() - kHeaderBytes;
+  bool has_signature = false;
+  if (body == after_header) {
+    has_signature = false;
+  } else if (after_header >= kSignatureBytes && body == after_header - kSignatureBytes) {
+    has_signature = true;
+  } else {
+    refuse(name, "checksum mismatch (file corrupted or truncated: the seal holds " + std::to_string(body) + " bytes, the file " +
+                     std::to_string(after_header) + ")");
+  }
+  Digest stored;
+  std::memcpy(stored.data(), bytes.data() + 20, stored.size());
+  if (sha256(std::string_view(bytes).substr(kHeaderBytes, body)) != stored)
+    refuse(name, "checksum mismatch (file corrupted or truncated)");
+
+  Envelope e;
+  e.body_end = kHeaderBytes + body;
+  const auto kind_bytes = body >= 4 ? podAt<std::uint32_t>(bytes, kHeaderBytes) : kMaxKindBytes + 1;
+  if (kind_bytes > kMaxKindBytes || 4 + std::uint64_t{kind_bytes} > body) refuse(name, "a seal without a valid kind");
+  e.kind = bytes.substr(kHeaderBytes + 4, kind_bytes);
+  e.payload_offset = kHeaderBytes + 4 + kind_bytes;
+  e.payload_size = body - 4 - kind_bytes;
+  if (has_signature) {
+    const std::size_t at = e.body_end;
+    if (bytes.compare(at, kSignatureMagic.size(), kSignatureMagic) != 0) refuse(name, "damaged signature block");
+    PublicKeyBytes key;
+    SignatureBytes sig;
+    std::memcpy(key.data(), bytes.data() + at + 8, key.size());
+    std::memcpy(sig.data(), bytes.data() + at + 8 + key.size(), sig.size());
+    if (!verifySignature(key, signedMessage(bytes), sig))
+      refuse(name, "signature does not verify (file corrupted or tampered with; key " + keyFingerprint(key) + ")");
+    e.signer = key;
+  }
+  return e;
+}
+
+std::string readWholeFile(const std::string& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) refuse(path, "cannot read (" + ec.message() + ")");
+  if (size > kMaxFileBytes) refuse(path, "too large for a masa file (" + std::to_string(size) + " bytes)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) refuse(path, "cannot open");
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (in.gcount() != static_cast<std::streamsize>(bytes.size())) refuse(path, "changed size while read");
+  return bytes;
+}
+
+// Temporary file, flushed to the disk, renamed over `path`: a reader sees the old file or the new
+// one, never half of one, even after a crash.
+void writeAtomically(const std::string& path, std::string_view bytes) {
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) refuse(tmp, std::string("cannot write (") + std::strerror(errno) + ")");
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
+  if (std::fclose(f) != 0 || !ok) {
+    std::remove(tmp.c_str());
+    refuse(tmp, "write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) refuse(path, "cannot rename " + tmp + " to it (" + ec.message() + ")");
+}
+
+}  // namespace
+
+std::string OpenedFile::describe() const {
+  if (!sealed) return "unsealed (written before masa sealed its files: not checked)";
+  return signer ? "sealed (SHA-256 checked), signed by " + keyFingerprint(*signer) : "sealed (SHA-256 checked), unsigned";
+}
+
+std::string sealBytes(const FileKind& kind, std::string_view payload) {
+  std::string body;
+  body.reserve(4 + kind.name.size() + payload.size());
+  appendPod(body, static_cast<std::uint32_t>(kind.name.size()));
+  body.append(kind.name);
+  body.append(payload);
+  std::string out;
+  out.reserve(kHeaderBytes + body.size());
+  out.append(kSealMagic);
+  appendPod(out, kEnvelopeVersion);
+  appendPod(out, static_cast<std::uint64_t>(body.size()));
+  const Digest d = sha256(body);
+  out.append(reinterpret_cast<const char*>(d.data()), d.size());
+  out.append(body);
+  return out;
+}
+
+void writeSealedFile(const std::string& path, const FileKind& kind, std::string_view payload) {
+  writeAtomically(path, sealBytes(kind, payload));
+}
+
+OpenedFile openSealedBytes(std::string bytes, const std::string& name, const FileKind& kind, const ReadRules& rules) {
+  OpenedFile out;
+  if (std::string_view(bytes).substr(0, kSealMagic.size()) != kSealMagic) {
+    if (kind.legacy_magic.empty() || std::string_view(bytes).substr(0, kind.legacy_magic.size()) != kind.legacy_magic)
+      refuse(name, "not a " + std::string(kind.name) + " file (no seal, and not the format's own start)");
+    if (rules.require_signed_by)
+      refuse(name, "not signed (written before masa sealed its files; masa_seal add, then masa_seal sign)");
+    if (rules.warn_unsealed)
+      std::fprintf(stderr, "masa: warning: %s: written before masa sealed its files, so no checksum proves it intact (masa_seal add %s seals it)\n",
+                   name.c_str(), name.c_str());
+    out.payload = std::move(bytes);
+    return out;
+  }
+  const Envelope e = checkEnvelope(bytes, name);
+  if (e.kind != kind.name) refuse(name, "a " + e.kind + " file, not a " + std::string(kind.name) + " file");
+  if (rules.require_signed_by) {
+    if (!e.signer) refuse(name, "not signed, and a signature by a trusted key is required (masa_seal sign)");
+    if (!rules.require_signed_by->contains(*e.signer))
+      refuse(name, "signed by " + keyFingerprint(*e.signer) + ", which is not a trusted key (" + rules.require_signed_by->source() + ")");
+  }
+  out.sealed = true;
+  out.signer = e.signer;
+  out.payload = bytes.substr(e.payload_offset, e.payload_size);
+  return out;
+}
+
+OpenedFile readSealedFile(const std::string& path, const FileKind& kind, const ReadRules& rules) {
+  return openSealedBytes(readWholeFile(path), path, kind, rules);
+}
+
+std::string sealedKindOf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(kHeaderBytes + 4 + kMaxKindBytes, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (head.size() < kHeaderBytes + 4 || head.compare(0, kSealMagic.size(), kSealMagic) != 0) return "";
+  const auto n = podAt<std::uint32_t>(head, kHeaderBytes);
+  if (n > kMaxKindBytes || kHeaderBytes + 4 + n > head.size()) return "";
+  return head.substr(kHeaderBytes + 4, n);
+}
+
+bool looksLikeKind(const std::string& path, const FileKind& kind) {
+  if (sealedKindOf(path) == kind.name) return true;
+  std::ifstream in(path, std::ios::binary);
+  std::string head(kind.legacy_magic.size(), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  return in && !kind.legacy_magic.empty() && head == kind.legacy_magic;
+}
+
+void signSealedFile(const std::string& path, const SigningKey& key) {
+  std::string bytes = readWholeFile(path);
+  if (std::string_view(bytes).substr(0, kSealMagic.size()) != kSealMagic)
+    refuse(path, "not sealed, so it cannot be signed (masa_seal add seals it)");
+  const Envelope e = checkEnvelope(bytes, path);
+  bytes.resize(e.body_end);  // any earlier signature goes
+  const SignatureBytes sig = key.sign(signedMessage(bytes));
+  const PublicKeyBytes pub = key.publicKey();
+  bytes.append(kSignatureMagic);
+  bytes.append(reinterpret_cast<const char*>(pub.data()), pub.size());
+  bytes.append(reinterpret_cast<const char*>(sig.data()), sig.size());
+  writeAtomically(path, bytes);
+}
+
+}  // namespace masa::integrity

@@ -1,0 +1,188 @@
+// The seal every masa file carries (common/integrity/sealed_file.hpp): a payload round-trips; a
+// single bit flipped anywhere, a cut at any length, another kind, a damaged signature are refused
+// by name and reason; a file from before the seal loads with a warning naming it, or is refused
+// where a signature is required; a signature counts only when its key is trusted. Ed25519 keys:
+// a private key readable by others is refused, an existing key is never overwritten.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+
+#include "common/integrity/ed25519_keys.hpp"
+#include "common/integrity/sealed_file.hpp"
+#include "common/integrity/sha256.hpp"
+#include "file_mutations.hpp"
+
+namespace masa::integrity {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr FileKind kToyKind{"masa toy", "TOYFMT01"};
+constexpr FileKind kOtherKind{"masa other", "OTHER001"};
+
+fs::path scratchDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("masa_sealed_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string toyPayload(std::size_t n) {
+  std::string p = "TOYFMT01";
+  std::mt19937_64 rng(7);
+  while (p.size() < n) p.push_back(static_cast<char>(rng()));
+  return p;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+std::string refusal(const std::string& bytes, const FileKind& kind = kToyKind, const ReadRules& rules = {}) {
+  try {
+    openSealedBytes(bytes, "toy.bin", kind, rules);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Sha256, MatchesTheStandardTestVector) {
+  EXPECT_EQ(toHex(sha256("abc")), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+}
+
+TEST(SealedFile, APayloadRoundTripsThroughAFileWrittenAtomically) {
+  const fs::path dir = scratchDir("roundtrip");
+  const std::string payload = toyPayload(1000);
+  writeSealedFile((dir / "toy.bin").string(), kToyKind, payload);
+  EXPECT_FALSE(fs::exists(dir / "toy.bin.tmp"));
+  const OpenedFile f = readSealedFile((dir / "toy.bin").string(), kToyKind);
+  EXPECT_EQ(f.payload, payload);
+  EXPECT_TRUE(f.sealed);
+  EXPECT_FALSE(f.signer);
+  EXPECT_TRUE(looksLikeKind((dir / "toy.bin").string(), kToyKind));
+  EXPECT_FALSE(looksLikeKind((dir / "toy.bin").string(), kOtherKind));
+  EXPECT_EQ(sealedKindOf((dir / "toy.bin").string()), "masa toy");
+}
+
+TEST(SealedFile, EverySingleBitFlipAndEveryCutIsRefusedWithTheFileAndTheReason) {
+  const std::string sealed = sealBytes(kToyKind, toyPayload(300));
+  for (std::size_t i = 0; i < sealed.size(); ++i) {
+    for (int bit = 0; bit < 8; ++bit) {
+      std::string b = sealed;
+      b[i] ^= static_cast<char>(1 << bit);
+      const std::string why = refusal(b);
+      ASSERT_NE(why, "") << "byte " << i << " bit " << bit << " flipped was accepted";
+      ASSERT_EQ(why.rfind("toy.bin: ", 0), 0u) << why;
+    }
+  }
+  for (std::size_t n = 0; n < sealed.size(); ++n) ASSERT_NE(refusal(sealed.substr(0, n)), "") << "cut to " << n << " bytes";
+  EXPECT_EQ(refusal(sealed + "x"), "toy.bin: checksum mismatch (file corrupted or truncated: the seal holds 312 bytes, the file 313)");
+  std::string flipped = sealed;
+  flipped[200] ^= 1;
+  EXPECT_EQ(refusal(flipped), "toy.bin: checksum mismatch (file corrupted or truncated)");
+}
+
+TEST(SealedFile, OneKindIsNeverReadAsAnother) {
+  const std::string sealed = sealBytes(kOtherKind, toyPayload(100));
+  EXPECT_EQ(refusal(sealed), "toy.bin: a masa other file, not a masa toy file");
+  EXPECT_NE(refusal("OTHER001 and the rest").find("not a masa toy file"), std::string::npos);
+}
+
+TEST(SealedFile, AnUnsealedFileLoadsWithAWarningNamingItUnlessASignatureIsRequired) {
+  const std::string legacy = toyPayload(200);
+  ::testing::internal::CaptureStderr();
+  const OpenedFile f = openSealedBytes(legacy, "old/toy.bin", kToyKind);
+  const std::string warning = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(f.payload, legacy);
+  EXPECT_FALSE(f.sealed);
+  EXPECT_NE(warning.find("warning: old/toy.bin: written before masa sealed its files"), std::string::npos) << warning;
+  EXPECT_EQ(std::count(warning.begin(), warning.end(), '\n'), 1) << "one line";
+  TrustedKeys trusted;
+  ReadRules rules;
+  rules.require_signed_by = &trusted;
+  EXPECT_NE(refusal(legacy, kToyKind, rules).find("toy.bin: not signed"), std::string::npos);
+}
+
+TEST(SealedFile, OnlyASignatureByATrustedKeyIsAcceptedWhereOneIsRequired) {
+  const fs::path dir = scratchDir("signed");
+  const PublicKeyBytes release = generateKeyPair((dir / "release.key").string(), (dir / "release.pub").string());
+  generateKeyPair((dir / "stranger.key").string(), (dir / "stranger.pub").string());
+  const TrustedKeys trusted = TrustedKeys::load((dir / "release.pub").string());
+  ASSERT_TRUE(trusted.contains(release));
+  ReadRules rules;
+  rules.require_signed_by = &trusted;
+  const std::string path = (dir / "toy.bin").string();
+  const std::string payload = toyPayload(500);
+
+  writeSealedFile(path, kToyKind, payload);
+  EXPECT_NE(refusal(slurp(path), kToyKind, rules).find("not signed, and a signature by a trusted key is required"), std::string::npos);
+
+  signSealedFile(path, SigningKey::load((dir / "stranger.key").string()));
+  const std::string by_stranger = refusal(slurp(path), kToyKind, rules);
+  EXPECT_NE(by_stranger.find("which is not a trusted key"), std::string::npos) << by_stranger;
+  EXPECT_EQ(readSealedFile(path, kToyKind).payload, payload) << "a valid signature by anyone is still an intact file";
+
+  signSealedFile(path, SigningKey::load((dir / "release.key").string()));
+  const OpenedFile f = readSealedFile(path, kToyKind, rules);
+  EXPECT_EQ(f.payload, payload);
+  ASSERT_TRUE(f.signer);
+  EXPECT_EQ(*f.signer, release);
+  EXPECT_NE(f.describe().find("signed by " + keyFingerprint(release)), std::string::npos);
+
+  // Every bit of a signed file matters, the signature's too, with or without a required signer.
+  const std::string signed_bytes = slurp(path);
+  for (std::size_t i = 0; i < signed_bytes.size(); i += (i < 80 || i + 120 > signed_bytes.size()) ? 1 : 7) {
+    std::string b = signed_bytes;
+    b[i] ^= static_cast<char>(1 << (i % 8));
+    ASSERT_NE(refusal(b), "") << "byte " << i;
+  }
+  // A directory of trusted keys holds every *.pub in it.
+  const TrustedKeys both = TrustedKeys::load(dir.string());
+  EXPECT_EQ(both.keys().size(), 2u);
+}
+
+TEST(SealedFile, KeysAreFilesThatAreNeverOverwrittenAndAPrivateKeyOthersMayReadIsRefused) {
+  const fs::path dir = scratchDir("keys");
+  generateKeyPair((dir / "a.key").string(), (dir / "a.pub").string());
+  struct stat st {};
+  ASSERT_EQ(::stat((dir / "a.key").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  EXPECT_THROW(generateKeyPair((dir / "a.key").string(), (dir / "b.pub").string()), std::runtime_error);
+  fs::permissions(dir / "a.key", fs::perms::group_read, fs::perm_options::add);
+  try {
+    SigningKey::load((dir / "a.key").string());
+    FAIL() << "a group-readable private key was loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("readable by others"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "junk.pub") << "not a key\n";
+  EXPECT_THROW(TrustedKeys::load((dir / "junk.pub").string()), std::runtime_error);
+}
+
+// Random damage of every kind: no crash, and nothing but the intact bytes accepted.
+TEST(SealedFile, RandomMutationsAreRefusedUnlessTheyLeaveTheBytesAsTheyWere) {
+  const std::string sealed = sealBytes(kToyKind, toyPayload(2000));
+  std::mt19937_64 rng(20261203);
+  int refused = 0, unchanged = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const fuzz::FileMutation m = fuzz::mutateFile(sealed, rng);
+    if (m.bytes == sealed) {
+      ++unchanged;
+      continue;
+    }
+    ASSERT_NE(refusal(m.bytes), "") << "mutation " << i << " (" << m.what << ") accepted";
+    ++refused;
+  }
+  EXPECT_GT(refused, 1900);
+}
+
+}  // namespace
+}  // namespace masa::integrity
