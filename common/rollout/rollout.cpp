@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "common/core/check.hpp"
+#include "common/rollout/rollout_fields.hpp"
 
 namespace masa::rollout {
 
@@ -18,33 +19,16 @@ void Rollout::allocate(int e, int t, int od, int ad, const std::vector<std::stri
   act_dim = ad;
   term_names = names;
   const std::size_t steps = static_cast<std::size_t>(t) * e;
-  obs.assign((steps + e) * od, 0.0f);
-  actions.assign(steps * ad, 0.0f);
-  mean.assign(steps * ad, 0.0f);
-  log_prob.assign(steps, 0.0f);
-  reward.assign(steps, 0.0f);
-  terminated.assign(steps, 0);
-  truncated.assign(steps, 0);
+  // Every array from the one list of the rollout's fields (rollout_fields.hpp): zero-filled steps,
+  // event lists reserved for one event per step, so adding never allocates.
+  forEachStepArray(*this, od, ad, [&](auto& a, int width, int extra_rows) { a.assign((steps + extra_rows * e) * width, 0); });
   env_log_std.assign(static_cast<std::size_t>(e) * ad, 0.0f);
   clearEvents();
-  final_index.reserve(steps);
-  final_obs.reserve(steps * od);
-  episode_env.reserve(steps);
-  episode_return.reserve(steps);
-  episode_length.reserve(steps);
-  episode_success.reserve(steps);
-  episode_term_sums.reserve(steps * names.size());
+  forEachFinalArray(*this, od, [&](auto& a, int width) { a.reserve(steps * width); });
+  forEachEpisodeArray(*this, numTerms(), [&](auto& a, int width) { a.reserve(steps * width); });
 }
 
-void Rollout::clearEvents() {
-  final_index.clear();
-  final_obs.clear();
-  episode_env.clear();
-  episode_return.clear();
-  episode_length.clear();
-  episode_success.clear();
-  episode_term_sums.clear();
-}
+void Rollout::clearEvents() { rollout::clearEvents(*this); }
 
 void Rollout::addFinal(int t, int e, const float* pre_reset_obs) {
   MASA_CHECK(t >= 0 && t < horizon && e >= 0 && e < num_envs, "final step (" << t << ", " << e << ") out of range");
