@@ -196,7 +196,16 @@ bool Learner::step(int timeout_ms) {
     if (!batch && collector_ && round_.settled(std::chrono::steady_clock::now()))
       batch = collector_->takeShort(*buffer_, min_batch_envs_);
     const bool stopping = stop_ && stop_->load();
-    if (ranks_->size() > 1 && (batch || stopping)) {
+    // A rank whose actors died (or cannot reach its URL) would never bring a batch, and the others
+    // would wait for it in the barrier for ever: after runner.rank_silence_stop_s it stops them all.
+    entered_silent_ = !batch && ranks_->size() > 1 && rc_.runner.rank_silence_stop_s > 0 &&
+                      silence_->silentFor(std::chrono::steady_clock::now()) >= rc_.runner.rank_silence_stop_s;
+    if (entered_silent_)
+      std::cerr << "masa_learner " << ranks_->describe() << ": no rollout data for "
+                << silence_->silentFor(std::chrono::steady_clock::now()) << " s (runner.rank_silence_stop_s "
+                << rc_.runner.rank_silence_stop_s << "): its actors died or cannot reach '"
+                << (opt_.rollout_url.empty() ? opt_.url : opt_.rollout_url) << "'; stopping every rank" << std::endl;
+    if (ranks_->size() > 1 && (batch || stopping || entered_silent_)) {
       // The update is collective: wait for every rank's batch (or stop), receiving chunks meanwhile.
       ranks_->beginBarrier();
       waiting_for_ranks_ = true;
@@ -209,10 +218,15 @@ bool Learner::step(int timeout_ms) {
     waiting_for_ranks_ = false;
     // Every rank is here with a batch or a stop: all stop together if any stops (a signal reaches
     // every rank of a job, but not at the same update), else all update.
-    double stopping = stop_ && stop_->load() ? 1.0 : 0.0;
-    ranks_->sum(&stopping, 1);
-    if (stopping > 0) {
+    double stopping[2] = {stop_ && stop_->load() ? 1.0 : 0.0, entered_silent_ ? 1.0 : 0.0};
+    ranks_->sum(stopping, 2);
+    if (stopping[0] + stopping[1] > 0) {
       ranks_stopped_ = true;
+      silent_ranks_at_stop_ = static_cast<int>(stopping[1]);
+      if (silent_ranks_at_stop_ > 0 && isLeadRank())
+        std::cerr << "masa_learner: the learner ranks stop at update " << updates_ << ": " << silent_ranks_at_stop_
+                  << " of " << ranks_->size() << " heard no rollout data for " << rc_.runner.rank_silence_stop_s
+                  << " s (see their messages); resume from the checkpoint once their actors run" << std::endl;
     } else {
       update();
       updated = true;

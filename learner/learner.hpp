@@ -103,6 +103,9 @@ class Learner {
   int64_t droppedEnvs() const;
   // Updates that ran on a batch short of lost environments (runner.min_batch_fraction).
   int64_t shortBatches() const { return collector_ ? collector_->stats().short_batches : 0; }
+  // Data-parallel ranks: how many ranks heard no rollout data for runner.rank_silence_stop_s and so
+  // stopped the run (0: it was not stopped that way).
+  int silentRanksAtStop() const { return silent_ranks_at_stop_; }
   const UpdateReport& lastReport() const { return report_; }
 
  private:
@@ -133,6 +136,8 @@ class Learner {
   int rank_envs_;  // this rank's environments of a full batch
   bool waiting_for_ranks_ = false;  // a batch is taken (or a stop asked); the ranks' barrier is pending
   bool ranks_stopped_ = false;      // the ranks agreed to stop
+  bool entered_silent_ = false;     // this rank entered the barrier because it heard nothing for too long
+  int silent_ranks_at_stop_ = 0;
   const std::atomic<bool>* stop_ = nullptr;  // run()'s
   std::unique_ptr<transport::Transport> transport_;
   std::unique_ptr<transport::Transport> policy_transport_;  // rank 0, when the rollouts come on another URL

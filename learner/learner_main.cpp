@@ -150,7 +150,15 @@ int main(int argc, char** argv) {
     }
     // run() finishes the step in progress when a signal arrives, then checkpoints.
     learner.run(max_updates, &g_stop);
-    if (job) job->finishTraining();  // the job's actors stop
+    // Ranks stopped because one heard no rollout data: its actors may be alive but hung, and would
+    // never join the end-of-training barrier; the learner ranks meet alone (rank 0's checkpoint is
+    // then written) and end the job below.
+    const bool cut_short = learner.silentRanksAtStop() > 0;
+    if (job && !cut_short) job->finishTraining();  // the job's actors stop
+    if (job && cut_short) {
+      double here = 1;
+      ranks->sum(&here, 1);
+    }
     std::cout << who << ": stopped after " << learner.updates() << " updates"
               << (lead ? "; checkpoint written" : "") << std::endl;
     // What became of the actors' rollout chunks, by reason (lost: never arrived).
@@ -165,6 +173,13 @@ int main(int argc, char** argv) {
     std::cout << who << ": MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
     std::cout << who << ": other messages rejected before decoding: " << learner.transport().rejectSummary()
               << std::endl;
+    // Stopped because a rank heard nothing: not the run's end, so not success for a job script,
+    // and the job's actors end with it (MPI_Abort), hung or not.
+    if (cut_short) {
+      std::cerr << who << ": ending the job (exit 3): a learner rank heard no rollout data" << std::endl;
+      if (job) job->abort(3);
+      return 3;
+    }
   } catch (const std::exception& e) {
     std::cerr << who << ": " << e.what() << "\n";
     // A rank that stops alone would leave the others waiting in a collective: end the job.

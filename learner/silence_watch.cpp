@@ -20,6 +20,8 @@ void SilenceWatch::heard(int actor_id, Clock::time_point now) {
   dropped_at_last_data_ = -1;
 }
 
+double SilenceWatch::silentFor(Clock::time_point now) const { return seconds(now - last_data_); }
+
 std::optional<std::string> SilenceWatch::check(Clock::time_point now, int64_t update, int64_t dropped_chunks) {
   if (dropped_at_last_data_ < 0) dropped_at_last_data_ = dropped_chunks;
   if (warn_after_s_ <= 0) return std::nullopt;

@@ -27,6 +27,9 @@ class SilenceWatch {
   // into the text: chunks dropped during the silence point at a mismatched sender.
   std::optional<std::string> check(Clock::time_point now, int64_t update, int64_t dropped_chunks);
 
+  // Seconds since the last accepted chunk (or since the start, when none came yet).
+  double silentFor(Clock::time_point now) const;
+
  private:
   struct Heard {
     Clock::time_point last;

@@ -330,6 +330,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   u.eval_every = r.atLeast("runner.eval_every", 0);
   u.eval_episodes = r.atLeast("runner.eval_episodes", 1);
   u.silence_warn_s = r.nonNegative("runner.silence_warn_s");
+  u.rank_silence_stop_s = r.nonNegative("runner.rank_silence_stop_s");
   u.snapshot_every = r.atLeast("runner.snapshot_every", 0);
   u.min_batch_fraction = r.positive("runner.min_batch_fraction");
   if (u.min_batch_fraction > 1.0)

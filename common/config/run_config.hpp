@@ -48,6 +48,9 @@ struct RunnerConfig {
   int eval_every = 50;             // updates between evaluations of the policy mean (0: never)
   int eval_episodes = 8;           // episodes per evaluation
   double silence_warn_s = 30.0;    // seconds without rollout data before the learner says so (0: never)
+  // Data-parallel ranks: a rank that hears no rollout data this long (its actors died or cannot
+  // reach its URL) stops every rank, after a checkpoint, instead of leaving them waiting (0: never).
+  double rank_silence_stop_s = 120.0;
   int snapshot_every = 0;          // updates between kept policies/policy_uNNNNNN.bin (0: none)
   // A batch short of lost environments forms once this share of ppo.num_envs arrived and the rest
   // is known lost (learner/intake/round_tracker.hpp); 1: batches are always full.

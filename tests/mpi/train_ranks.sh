@@ -9,6 +9,9 @@
 #  2. Resumed as a new job from rank 0's checkpoint, it goes on to the new total.
 #  3. A learner rank killed with SIGKILL ends the whole job within seconds (no hang).
 #  4. Ctrl-C of mpirun (SIGINT) stops every process within seconds, the learners after a checkpoint.
+#  5. An actor frozen (SIGSTOP: dead to its rank, alive to mpirun): its rank hears nothing for
+#     runner.rank_silence_stop_s and stops every rank with the reason, after a checkpoint, exit 3;
+#     the job ends (it waited for ever before).
 #   tests/mpi/train_ranks.sh [BUILD_DIR]
 set -euo pipefail
 source "$(dirname "$0")/../integration/lib.sh"
@@ -86,4 +89,17 @@ mpirun_pid=$(pgrep -f "^mpirun .*run_int" | head -n 1) || fail "no mpirun"
 kill -INT "$mpirun_pid"
 stop_and_check "Ctrl-C"
 [ -f "$work/run_int/checkpoint.bin" ] || fail "no checkpoint after Ctrl-C"
+
+log "5. one actor frozen: its rank stops the job after runner.rank_silence_stop_s (4 s)"
+sets+=(--set runner.rank_silence_stop_s=4)
+start_long_job run_silent
+frozen=$(pgrep -f "^$actor_bin .*seed=$marker" | head -n 1) || fail "no actor to freeze"
+kill -STOP "$frozen"
+stop_and_check "an actor froze"
+kill -CONT "$frozen" 2> /dev/null || true
+grep -q "no rollout data for .* stopping every rank" "$work/run_silent.log" || fail "the silent rank said nothing"
+grep -q "the learner ranks stop at update .*: 1 of 2 heard no rollout data" "$work/run_silent.log" ||
+  fail "rank 0 did not say why the ranks stopped"
+wait "$launcher" && fail "the job ended with status 0 although it stopped short"
+[ -f "$work/run_silent/checkpoint.bin" ] || fail "no checkpoint after the silent stop"
 echo "PASS"

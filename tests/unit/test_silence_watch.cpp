@@ -43,3 +43,16 @@ TEST(SilenceWatch, ZeroNeverWarns) {
   SilenceWatch w(0.0, t0);
   EXPECT_FALSE(w.check(t0 + seconds(100000), 0, 0));
 }
+
+// What stops data-parallel ranks whose actors died: the time since the last accepted chunk, from the
+// start when none came, and back to zero with the next chunk.
+TEST(SilenceWatch, SilentForCountsFromTheStartOrTheLastChunk) {
+  const auto t0 = SilenceWatch::Clock::time_point{};
+  SilenceWatch w(30.0, t0);
+  EXPECT_DOUBLE_EQ(w.silentFor(t0 + seconds(7)), 7.0);
+  w.heard(3, t0 + seconds(10));
+  EXPECT_DOUBLE_EQ(w.silentFor(t0 + seconds(10)), 0.0);
+  EXPECT_DOUBLE_EQ(w.silentFor(t0 + seconds(135)), 125.0);
+  w.check(t0 + seconds(140), 2, 0);  // a warning does not reset it
+  EXPECT_DOUBLE_EQ(w.silentFor(t0 + seconds(140)), 130.0);
+}
