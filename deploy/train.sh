@@ -8,6 +8,8 @@
 #                   method, batch and ppo.max_updates updates; its environments split over the actors)
 #   deploy/train.sh [task] [method] --hosts FILE [--envs E] [--updates N] [--set key=value ...]
 #   deploy/train.sh --resume RUN_DIR [--actors K] [--envs E] [--updates N]   (N counts all updates)
+#   deploy/train.sh ... --ranks L   (L data-parallel learner ranks on this machine: the same MPI job as
+#                   on a cluster, started by deploy/cluster/mpirun_train.sh; L must divide K and E*K)
 # FILE has one host per line, "host [actors] [envs]" (default 1 actor of E environments), '#'
 # comments; "localhost" runs its actors here without ssh. See deploy/hosts.example.
 # Every message is authenticated with the run's key, RUN_DIR/run.key (made here before anything
@@ -28,7 +30,7 @@ cd "$(dirname "$0")/.."
 task=a1_beam method=masa task_given=0 method_given=0
 [ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; task_given=1; shift; }
 [ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; method_given=1; shift; }
-actors=2 envs=32 envs_given=0 updates="" hosts_file="" actors_given=0 resume="" recipe="" run_dir_given="" no_auth=0
+actors=2 envs=32 envs_given=0 updates="" hosts_file="" actors_given=0 resume="" recipe="" run_dir_given="" no_auth=0 ranks=1
 sets=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -41,6 +43,7 @@ while [ $# -gt 0 ]; do
     --hosts) hosts_file=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
     --no-auth) no_auth=1; shift ;;
+    --ranks) ranks=$2; shift 2 ;;
     *) echo "train.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
@@ -68,6 +71,41 @@ if [ -n "$recipe" ]; then
   fi
 fi
 updates=${updates:-200}
+# A resumed run's environments: its config's, over the actors, unless --envs says otherwise.
+if [ -n "$resume" ] && [ "$envs_given" = 0 ] && [ -z "$hosts_file" ] && [ -r "$resume/config.yaml" ]; then
+  run_envs=$(sed -n 's/^  num_envs: //p' "$resume/config.yaml")
+  if [[ $run_envs =~ ^[0-9]+$ ]] && (( run_envs % actors == 0 )); then envs=$((run_envs / actors)); fi
+fi
+
+# Data-parallel learner ranks: the job a cluster runs (every process takes its role, actor id, URL
+# and the run key from the MPI job, docs/scaling.md), here on this machine, so one machine and many
+# share one role logic. One rank (the default) is the plain learner below and needs no MPI.
+[[ $ranks =~ ^[1-9][0-9]*$ ]] || { echo "train.sh: --ranks '$ranks' is not a positive count" >&2; exit 2; }
+if [ "$ranks" -gt 1 ]; then
+  [ -z "$hosts_file" ] || { echo "train.sh: --ranks with --hosts: on several machines use deploy/cluster/mpirun_train.sh --hostfile or deploy/cluster/slurm_train.sbatch" >&2; exit 2; }
+  command -v "${MASA_MPIRUN:-mpirun}" > /dev/null ||
+    { echo "train.sh: --ranks needs Open MPI's mpirun (bash scripts/install_deps.sh installs it, then build again)" >&2; exit 2; }
+  (( actors % ranks == 0 )) || { echo "train.sh: $actors actors do not divide among $ranks learner ranks (each rank takes its share)" >&2; exit 2; }
+  job=("$task" "$method" --ranks "$ranks" --actors "$actors" --envs "$envs" --updates "$updates")
+  [ "$no_auth" = 0 ] || job+=(--no-auth)
+  if [ -n "$resume" ]; then
+    for f in checkpoint.bin config.yaml; do
+      [ -r "$resume/$f" ] || { echo "train.sh: $resume/$f is missing: not a run directory" >&2; exit 2; }
+    done
+    job+=(--resume "$resume" "${sets[@]+"${sets[@]}"}")
+  else
+    run_dir=${run_dir_given:-"${MASA_RUNS_DIR:-runs}/${task}_${method}_$(date +%Y%m%d_%H%M%S)"}
+    job+=(--run-dir "$run_dir")
+    if [ -n "$recipe" ]; then
+      job+=(--set "@$recipe" --set "task=$task" --set "method=$method" --set "ppo.num_envs=$((actors * envs))")
+    else
+      job+=(--set ppo.horizon=32 --set ppo.minibatch_size=1024)  # sized for a small machine, as below
+    fi
+    job+=("${sets[@]+"${sets[@]}"}")
+  fi
+  echo "train.sh: $task / $method, $ranks learner ranks, $actors actors x $envs envs, $updates updates, one MPI job"
+  exec bash deploy/cluster/mpirun_train.sh "${job[@]}"
+fi
 
 # Actor placement: host, actor count and environments per actor, one entry per hosts-file line.
 hosts=() host_actors=() host_envs=()

@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <stdexcept>
+#include <string>
 
 #include <unistd.h>
 
@@ -19,12 +20,20 @@ bool builtWithMpi() {
 #endif
 }
 
-bool launchedByMpi() {
-  if (!builtWithMpi()) return false;
+bool launchedByMpi(bool built_with_mpi) {
+  bool launched = false;
   for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"})
-    if (std::getenv(var) != nullptr) return true;
-  return false;
+    if (std::getenv(var) != nullptr) launched = true;
+  if (!launched || built_with_mpi) return launched;
+  // Without MPI every process of the job would think itself alone: two learners on one URL.
+  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
+  if (size != nullptr && std::string(size) == "1") return false;
+  throw std::runtime_error(
+      "started by mpirun or srun as one process of a job, but this build has no MPI: install libopenmpi-dev "
+      "(bash scripts/install_deps.sh) and build again, or start the processes without mpirun (deploy/train.sh)");
 }
+
+bool launchedByMpi() { return launchedByMpi(builtWithMpi()); }
 
 #ifdef MASA_HAVE_MPI
 

@@ -22,7 +22,10 @@ enum class Role : int { kLearner = 0, kActor = 1 };
 
 // True when the environment says this process is a rank of an MPI launch (mpirun's
 // OMPI_COMM_WORLD_SIZE, or PMIx/PMI ranks as srun --mpi=pmix sets them) and this build has MPI.
+// A build without MPI started as one of several processes of such a launch throws (each process
+// would take itself for the only learner), saying what to install.
 bool launchedByMpi();
+bool launchedByMpi(bool built_with_mpi);  // the same, for this build or one without MPI (tests)
 bool builtWithMpi();
 
 class MpiJob {

@@ -6,7 +6,7 @@
 # writes the run directory and hands the run key to every process over MPI (never on a command
 # line). Ctrl-C stops the job; its checkpoint is resumable with --resume.
 #   deploy/cluster/mpirun_train.sh [task] [method] [--ranks L] [--actors A] [--envs E] [--threads T]
-#       [--hostfile FILE] [--updates N] [--run-dir DIR | --resume DIR] [--set key=value ...]
+#       [--hostfile FILE] [--updates N] [--run-dir DIR | --resume DIR] [--no-auth] [--set key=value ...]
 #       [-- extra mpirun options]
 # Defaults: 2 ranks, 2 actors of 32 environments, 1 thread each; ppo.num_envs = A x E, which the
 # ranks share equally. With --hostfile the URL is LAN multicast (ttl=1); see
@@ -18,7 +18,7 @@ cd "$(dirname "$0")/../.."
 task=a1_beam method=masa
 [ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; shift; }
 [ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; shift; }
-ranks=2 actors=2 envs=32 threads=1 hostfile="" updates="" run_dir="" resume=""
+ranks=2 actors=2 envs=32 threads=1 hostfile="" updates="" run_dir="" resume="" no_auth=0
 sets=() mpi_extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -31,6 +31,7 @@ while [ $# -gt 0 ]; do
     --run-dir) run_dir=$2; shift 2 ;;
     --resume) resume=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
+    --no-auth) no_auth=1; shift ;;
     --) shift; mpi_extra=("$@"); break ;;
     *) echo "mpirun_train.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -54,6 +55,7 @@ fi
 config=(--set "task=$task" --set "method=$method" --set "ppo.num_envs=$((actors * envs))" "${sets[@]}")
 learner_args=(--url "$url")
 [ -n "$updates" ] && learner_args+=(--max-updates "$updates")
+[ "$no_auth" = 0 ] || learner_args+=(--no-auth)  # the actors learn it from the job's plan
 if [ -n "$resume" ]; then
   learner_args+=(--resume "$resume")
   config=("${sets[@]}")

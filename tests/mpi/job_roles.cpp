@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,6 +27,14 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "FAILED (%s): %s\n", argv[1], what.c_str());
     }
   };
+  // A build without MPI, started as a process of this job, refuses: it would take itself for alone.
+  expect(launchedByMpi(), "mpirun's environment is seen");
+  try {
+    launchedByMpi(false);
+    expect(false, "a build without MPI in a job of 5 refuses to start");
+  } catch (const std::runtime_error& e) {
+    expect(std::string(e.what()).find("this build has no MPI") != std::string::npos, e.what());
+  }
   MpiJob job(learner ? Role::kLearner : Role::kActor);
   expect(job.learnerCount() == 2 && job.actorCount() == 3, "2 learner ranks and 3 actors in a job of 5");
   expect(job.roleIndex() == (learner ? job.worldRank() : job.worldRank() - 2), "the index among the role follows the world rank");

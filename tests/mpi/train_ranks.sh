@@ -12,6 +12,8 @@
 #  5. An actor frozen (SIGSTOP: dead to its rank, alive to mpirun): its rank hears nothing for
 #     runner.rank_silence_stop_s and stops every rank with the reason, after a checkpoint, exit 3;
 #     the job ends (it waited for ever before).
+#  6. deploy/train.sh --ranks 2, the one-machine entry, runs the same job (2 ranks, 2 actors) to its
+#     end; --ranks that do not divide the actors are refused before anything starts.
 #   tests/mpi/train_ranks.sh [BUILD_DIR]
 set -euo pipefail
 source "$(dirname "$0")/../integration/lib.sh"
@@ -102,4 +104,16 @@ grep -q "the learner ranks stop at update .*: 1 of 2 heard no rollout data" "$wo
   fail "rank 0 did not say why the ranks stopped"
 wait "$launcher" && fail "the job ended with status 0 although it stopped short"
 [ -f "$work/run_silent/checkpoint.bin" ] || fail "no checkpoint after the silent stop"
+
+log "6. deploy/train.sh --ranks 2: the same job from the one-machine entry"
+train_sh() { MASA_BUILD_DIR=$build MASA_LCM_URL=$url timeout 120 bash "$masa_repo/deploy/train.sh" "$@"; }
+train_sh a1_beam masa --ranks 3 --actors 2 --envs 8 --updates 3 > "$work/sh_bad.log" 2>&1 && fail "3 ranks for 2 actors accepted"
+grep -q "2 actors do not divide among 3 learner ranks" "$work/sh_bad.log" || fail "no reason for refusing 3 ranks"
+train_sh a1_beam masa --ranks 2 --actors 2 --envs 8 --updates 4 --run-dir "$work/run_sh" \
+  --set ppo.horizon=16 --set ppo.minibatch_size=128 --set seed=$marker --set "model.policy_hidden=[16]" \
+  --set "model.critic_hidden=[16]" > "$work/sh.log" 2>&1 || fail "train.sh --ranks 2 failed (exit $?)"
+[ "$(($(wc -l < "$work/run_sh/metrics.csv") - 1))" -eq 4 ] || fail "train.sh --ranks 2: not 4 updates"
+grep -q "rank 1 of 2: run id" "$work/sh.log" || fail "train.sh --ranks 2 ran no rank 1"
+[ "$(grep -c 'rollouts to learner rank' "$work/sh.log")" -eq 2 ] || fail "train.sh --ranks 2: the actors did not take their ranks from the job"
+log "   4 updates with 2 ranks; 3 ranks for 2 actors refused"
 echo "PASS"
