@@ -26,8 +26,13 @@ bool launchedByMpi(bool built_with_mpi) {
     if (std::getenv(var) != nullptr) launched = true;
   if (!launched || built_with_mpi) return launched;
   // Without MPI every process of the job would think itself alone: two learners on one URL.
-  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
-  if (size != nullptr && std::string(size) == "1") return false;
+  for (const char* var : {"OMPI_COMM_WORLD_SIZE", "SLURM_STEP_NUM_TASKS", "PMI_SIZE"}) {
+    const char* size = std::getenv(var);
+    if (size != nullptr) {
+      if (std::string(size) == "1") return false;  // a job of one process: alone indeed
+      break;
+    }
+  }
   throw std::runtime_error(
       "started by mpirun or srun as one process of a job, but this build has no MPI: install libopenmpi-dev "
       "(bash scripts/install_deps.sh) and build again, or start the processes without mpirun (deploy/train.sh)");
