@@ -153,11 +153,8 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
     std::copy(m.obs_mean.begin(), m.obs_mean.end(), pending_mean_.begin());
     std::copy(m.obs_std.begin(), m.obs_std.end(), pending_std_.begin());
   }
-  if (rollout_end_s_ > 0 && m.version > version_) {
-    // How long the learner took to answer the last rollout: the wait after the next one adapts to it.
-    await_budget_.observeAnswer(nowSeconds() - rollout_end_s_);
-    rollout_end_s_ = 0;
-  }
+  // How long the learner took to answer a rollout: the wait after the next one adapts to it.
+  if (const auto delay = lag_window_.answer(m.version, nowSeconds())) await_budget_.observeAnswer(*delay);
   pending_version_ = m.version;
   pending_has_norm_ = m.obs_dim > 0;
   last_learner_s_ = nowSeconds();
@@ -219,7 +216,11 @@ double Actor::awaitLimitSeconds() const {
 
 void Actor::awaitNewerParams() {
   const double deadline = nowSeconds() + awaitLimitSeconds();
-  for (double now = nowSeconds(); pending_version_ <= version_ && now < deadline && !stopRequested(); now = nowSeconds()) {
+  // With ppo.max_policy_lag 0 the parameters that answer the rollout just sent; with lag L those
+  // that answer the rollout L before it (PolicyLagWindow), so rollouts and updates overlap.
+  const int64_t needed = lag_window_.neededVersion();
+  for (double now = nowSeconds(); std::max(pending_version_, version_) < needed && now < deadline && !stopRequested();
+       now = nowSeconds()) {
     // Short slices: the stop flag and heartbeats are served while waiting.
     transport_->handleTimeout(static_cast<int>(std::min(100.0, std::ceil((deadline - now) * 1000.0))));
     transport_->drain();
@@ -306,7 +307,7 @@ bool Actor::collectAndPublish() {
     ++chunks_published_;
   }
   ++rollouts_sent_;
-  rollout_end_s_ = nowSeconds();
+  lag_window_.sent(acting_version, nowSeconds());
   return true;
 }
 

@@ -24,6 +24,7 @@
 #include "common/sim/registry.hpp"
 #include "actors/await_budget.hpp"
 #include "actors/params_check.hpp"
+#include "actors/policy_lag_window.hpp"
 #include "common/rollout/rollout.hpp"
 #include "actors/rollout_chunker.hpp"
 #include "common/transport/transport.hpp"
@@ -175,7 +176,8 @@ class Actor {
   std::vector<float> pending_params_, pending_mean_, pending_std_;
   int pending_count_ = 0;
   bool pending_has_norm_ = false;
-  double rollout_end_s_ = 0;    // when the last rollout was published (0: answered already)
+  // The rollouts sent and not yet answered, and what the next needs (config_ is declared above).
+  PolicyLagWindow lag_window_{config_.ppo.max_policy_lag};
   double last_learner_s_ = 0;   // when the learner was last heard (new parameters or its repeat)
   // The wait for newer parameters, adapted to the learner's answer time (options_ is declared above).
   AwaitBudget await_budget_{options_.await_params_s, options_.await_params_max_s, options_.await_params_min_s};

@@ -3,11 +3,13 @@
 # and A actors of E environments (ppo.num_envs = A x E, horizon 24, 4 minibatches) for N updates;
 # prints one line with the median fps after the warm-up (the learner's metrics.csv).
 #   bench/e2e_ranks.sh [task] --ranks L --actors A [--envs E] [--threads T] [--updates N] [--warmup W] [--out DIR]
+#                      [--lag G] [--set key=value ...]
+# --lag G: ppo.max_policy_lag (1: actors collect the next rollout while the learner learns).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 task=a1_beam
 [ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; shift; }
-ranks=1 actors=1 envs=32 threads=1 updates=20 warmup=5 out=""
+ranks=1 actors=1 envs=32 threads=1 updates=20 warmup=5 out="" lag=0 sets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --ranks) ranks=$2; shift 2 ;;
@@ -17,6 +19,8 @@ while [ $# -gt 0 ]; do
     --updates) updates=$2; shift 2 ;;
     --warmup) warmup=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
+    --lag) lag=$2; shift 2 ;;
+    --set) sets+=(--set "$2"); shift 2 ;;
     *) echo "e2e_ranks.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
@@ -26,9 +30,12 @@ samples=$((actors * envs * 24))
 MASA_LCM_URL="udpm://239.255.76.67:$((7600 + RANDOM % 50 * 8))?ttl=0&recv_buf_size=8388608" \
   deploy/cluster/mpirun_train.sh "$task" masa --ranks "$ranks" --actors "$actors" --envs "$envs" --threads "$threads" \
   --updates "$updates" --run-dir "$out/run" --set ppo.horizon=24 --set ppo.minibatch_size=$((samples / 4)) \
-  --set runner.eval_every=0 --set runner.plot_every=0 > "$out/train.log" 2>&1 ||
+  --set runner.eval_every=0 --set runner.plot_every=0 --set "ppo.max_policy_lag=$lag" "${sets[@]+"${sets[@]}"}" \
+  > "$out/train.log" 2>&1 ||
   { echo "e2e_ranks: $task ranks $ranks actors $actors FAILED (see $out/train.log)"; exit 1; }
 fps=$(awk -F, -v w="$warmup" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "fps") c = i; next } $1 > w { print $c }' \
   "$out/run/metrics.csv" | sort -g | awk '{ v[NR] = $1 } END { print NR ? (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) : "nan" }')
-printf 'e2e_ranks: %s ranks %d actors %d x %d envs, threads %d: fps median %.0f (updates %d-%d)\n' \
-  "$task" "$ranks" "$actors" "$envs" "$threads" "$fps" "$warmup" "$updates"
+dropped=$(tail -n 1 "$out/run/metrics.csv" | awk -F, -v h="$(head -n 1 "$out/run/metrics.csv")" \
+  'BEGIN { n = split(h, c, ","); for (i = 1; i <= n; i++) if (c[i] == "dropped_chunks") k = i } { print k ? $k : "?" }')
+printf 'e2e_ranks: %s ranks %d actors %d x %d envs, threads %d, lag %d: fps median %.0f (updates %d-%d), chunks dropped %s\n' \
+  "$task" "$ranks" "$actors" "$envs" "$threads" "$lag" "$fps" "$warmup" "$updates" "$dropped"

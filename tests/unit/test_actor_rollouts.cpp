@@ -458,6 +458,23 @@ TEST(ActorRollouts, BetweenRolloutsTheActorWaitsBoundedForNewerParameters) {
   EXPECT_GE(elapsed, 0.8) << "two waits of 0.4 s between three rollouts (none after the last)";
 }
 
+// With ppo.max_policy_lag 1 the actor collects its next rollout while the learner learns from the
+// last (no wait after the first rollout), but not a third before the first is answered.
+TEST(ActorRollouts, WithPolicyLagOneTheActorCollectsOneRolloutAheadAndWaitsBeforeTheNext) {
+  auto rc = smallConfig(8);
+  rc.ppo.max_policy_lag = 1;
+  transport::Transport bus("memq://");
+  auto opt = options(2, 3);
+  opt.start_without_learner = true;
+  opt.await_params_s = 1.0;
+  actor::Actor actor(rc, opt, &bus);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(actor.run(), 3);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(elapsed, 1.0) << "one wait, before the third rollout";
+  EXPECT_LT(elapsed, 1.9) << "no wait after the first rollout (with lag 0: two waits, 2 s)";
+}
+
 TEST(ActorRollouts, NewerParametersEndTheWaitAtOnce) {
   const auto rc = smallConfig(9);
   transport::Transport bus("memq://");

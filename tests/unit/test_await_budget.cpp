@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "actors/await_budget.hpp"
+#include "actors/policy_lag_window.hpp"
 
 using masa::actor::AwaitBudget;
 
@@ -34,4 +35,45 @@ TEST(AwaitBudget, IsBoundedAndCanBeSwitchedOff) {
   AwaitBudget off(0.0, 10.0);
   off.observeAnswer(5.0);
   EXPECT_DOUBLE_EQ(off.limitSeconds(), 0.0);
+}
+
+using masa::actor::PolicyLagWindow;
+
+// Lag 0: the next rollout needs the answer to the last; an answer is an answer once.
+TEST(PolicyLagWindow, LagZeroNeedsTheAnswerToTheLastRollout) {
+  PolicyLagWindow w(0);
+  EXPECT_EQ(w.neededVersion(), -1) << "nothing sent: nothing needed";
+  w.sent(3, 10.0);
+  EXPECT_EQ(w.neededVersion(), 4);
+  EXPECT_FALSE(w.answer(3, 10.5)) << "the learner's repeat of the version acted with answers nothing";
+  const auto delay = w.answer(4, 11.25);
+  ASSERT_TRUE(delay);
+  EXPECT_DOUBLE_EQ(*delay, 1.25);
+  EXPECT_FALSE(w.answer(5, 12.0)) << "already answered";
+  w.sent(5, 13.0);
+  EXPECT_EQ(w.neededVersion(), 6);
+}
+
+// Lag 1: one rollout may be unanswered when the next starts; the update that takes a rollout
+// comes after the one that takes the rollout before it.
+TEST(PolicyLagWindow, LagOneLetsOneRolloutBeUnansweredAndCountsTheUpdatesBeforeItsAnswer) {
+  PolicyLagWindow w(1);
+  w.sent(0, 1.0);  // answered by update 1
+  EXPECT_EQ(w.neededVersion(), -1) << "the second rollout goes ahead while the first is learned from";
+  w.sent(0, 2.0);  // acted with 0 too, but taken after the first: answered by update 2
+  EXPECT_EQ(w.neededVersion(), 1) << "the third needs the answer to the first";
+  const auto first = w.answer(1, 2.5);
+  ASSERT_TRUE(first);
+  EXPECT_DOUBLE_EQ(*first, 1.5) << "from the end of the first rollout";
+  w.sent(1, 3.0);  // the third, acted with version 1, taken after the second: update 3
+  EXPECT_EQ(w.neededVersion(), 2) << "the fourth needs update 2 (it takes the second rollout), not just any version above 0";
+  EXPECT_FALSE(w.answer(1, 3.2)) << "a repeat answers nothing";
+  const auto second = w.answer(2, 3.5);
+  ASSERT_TRUE(second);
+  EXPECT_DOUBLE_EQ(*second, 1.5) << "the second rollout's, ended at 2.0";
+  // Steady state: every rollout acted with the answer to the one two before it arrives one
+  // version behind the learner, within the lag.
+  w.sent(2, 4.0);
+  EXPECT_EQ(w.neededVersion(), 3);
+  EXPECT_THROW(PolicyLagWindow(-1), std::invalid_argument);
 }
