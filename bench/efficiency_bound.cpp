@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "actors/actor.hpp"
+#include "common/transport/channels.hpp"
 #include "common/config/run_config.hpp"
 #include "learner/learner.hpp"
 
@@ -62,6 +63,10 @@ int main(int argc, char** argv) {
     ao.incarnation = 1;  // bit-identical chunks from run to run
     ao.heartbeat_interval_s = 1e9;
     masa::actor::Actor actor(rc, ao, &learner.transport());
+    // What travels: rollout bytes per env step and one parameter message (the cost model's network terms).
+    double rollout_bytes = 0, params_bytes = 0;
+    learner.transport().subscribeRaw(masa::transport::kRolloutChannel, [&](const void*, int n) { rollout_bytes += n; });
+    learner.transport().subscribeRaw(masa::transport::kPolicyChannel, [&](const void*, int n) { params_bytes = n; });
     const double steps = static_cast<double>(rc.ppo.num_envs) * rc.ppo.horizon;
     std::vector<double> t_env, t_learn;
     for (int r = 0; r <= rounds; ++r) {
@@ -90,6 +95,8 @@ int main(int argc, char** argv) {
     std::printf("t_learn %.2f us per env step (learner core-seconds: intake, GAE, all mini-epochs)\n", l * 1e6);
     std::printf("share of the learner: %.2f\n", l / (e + l));
     std::printf("bound %.0f env steps/s on %d cores\n", cores / (e + l), cores);
+    std::printf("wire %.1f bytes per env step (rollout chunks), parameters %.0f bytes a message\n",
+                rollout_bytes / (steps * (rounds + 1)), params_bytes);
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "bench_efficiency_bound: %s\n", ex.what());
     return 2;

@@ -1,18 +1,23 @@
 #!/usr/bin/env bash
 # The many-core scaling tables of issue #30 in one short script, for a machine with C cores
-# (written for the 16-core device machine; about 8 minutes there). Results under OUT:
+# (written for a 16-core machine; about 10 minutes there). Results under OUT:
 #  1. learner_ranks.txt: the learner's update with ranks x threads = C (a1_beam, humanoid_tightrope)
-#  2. actors.txt: training fps against actor cores a = 1, 2, 4, 8, 12, 14 with L learner ranks by the
-#     rule "the divisor of a nearest 0.37 a (the measured learner/actor cost ratio, 43 us / 115 us
-#     per env step), with a + L <= C", each process on one core
-#  3. ranks.txt: training fps against L = 1, 2, 4 at a fixed 8 actors
-#   bench/scaling_device.sh [--cores C] [--out OUT]      (MASA_BUILD_DIR: the build, default build)
+#  2. check/: the per-sample costs measured here (costs.json) and the cost model checked at C cores
+#     (bench/scaling_check.sh)
+#  3. actors.txt: training fps on the first a cores, a = 1, 2, 4, 8, 12, 14 (a < C), with actors and
+#     learner ranks split by the documented rule: the split of those a cores that the cost model
+#     finds fastest on the costs of step 2 (bench/scaling_model.py plan, ppo.max_policy_lag 1: the
+#     actors collect while the learner learns); each against the bound a / (t_env + t_learn)
+#  4. ranks.txt: training fps against learner ranks L = 1, 2, 4, 8 at 8 actors sharing 8 cores
+#  5. model.txt: the model beside every point of 3 and 4
+#   bench/scaling_device.sh [--cores C] [--envs E] [--out OUT]      (MASA_BUILD_DIR: the build, default build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cores=$(nproc) out=${OUT:-/tmp/masa_scaling_device}
+cores=$(nproc) envs=128 out=${OUT:-/tmp/masa_scaling_device}
 while [ $# -gt 0 ]; do
   case "$1" in
     --cores) cores=$2; shift 2 ;;
+    --envs) envs=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     *) echo "scaling_device.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -21,34 +26,41 @@ mkdir -p "$out"
 machine=$(bash experiments/machine.sh 2> /dev/null || hostname)
 stamp() { echo "# $(date -u +%FT%TZ) $(git rev-parse --short HEAD 2> /dev/null || echo '?') on $machine: $*"; }
 
-rule() {  # rule A: learner ranks for A actors
-  local a=$1 best=1 d
-  for ((d = 1; d <= a; d++)); do
-    (( a % d == 0 && a + d <= cores )) || continue
-    awk -v d="$d" -v b="$best" -v a="$a" 'BEGIN { t = 0.37 * a; exit !((d - t)^2 < (b - t)^2) }' && best=$d
-  done
-  echo "$best"
-}
-
 {
   stamp "bench/learner_ranks.sh --cores $cores"
   bench/learner_ranks.sh a1_beam --cores "$cores" --updates 3 | grep -v '^#'
   bench/learner_ranks.sh humanoid_tightrope --cores "$cores" --updates 2 | grep -v '^#'
 } | tee "$out/learner_ranks.txt"
 
+bench/scaling_check.sh --cores "$cores" --envs "$envs" --out "$out/check"
+costs=$out/check/costs.json
+
+: > "$out/points.txt"
+run_on() {  # run_on CORES ACTORS RANKS LAG NAME: e2e_ranks.sh on the first CORES cores
+  local c=$1 a=$2 l=$3 lag=$4 line fps
+  line=$(taskset -c "0-$((c - 1))" bench/e2e_ranks.sh a1_beam --ranks "$l" --actors "$a" --envs "$envs" \
+    --updates 16 --warmup 5 --lag "$lag" --out "$out/$5") || true
+  fps=$(sed -n 's/.*fps median \([0-9.]*\) .*/\1/p' <<< "$line")
+  echo "$line (on $c cores)"
+  [ -n "$fps" ] && echo "fps $fps $a $envs 24 $l 1 $c $lag" >> "$out/points.txt"
+  return 0
+}
 {
-  stamp "training fps against actor cores (a1_beam, 32 envs an actor, horizon 24)"
+  stamp "training fps on the first a cores, split by the model's plan (lag 1)"
   for a in 1 2 4 8 12 14; do
-    (( a + 1 <= cores )) || continue
-    bench/e2e_ranks.sh a1_beam --ranks "$(rule "$a")" --actors "$a" --updates 16 --warmup 4 --out "$out/actors_$a" || true
+    (( a < cores || a == 1 )) || continue
+    read -r na nl <<< "$(python3 bench/scaling_model.py "$costs" plan "$envs" 24 --cores "$a" --lag 1 --terse)"
+    run_on "$a" "$na" "$nl" 1 "cores_$a"
   done
 } | tee "$out/actors.txt"
 
 {
-  stamp "training fps against learner ranks at 8 actors"
-  for l in 1 2 4; do
-    (( 8 + l <= cores )) || continue
-    bench/e2e_ranks.sh a1_beam --ranks "$l" --actors 8 --updates 16 --warmup 4 --out "$out/ranks_$l" || true
+  stamp "training fps against learner ranks, 8 actors sharing 8 cores with the ranks (lag 0)"
+  for l in 1 2 4 8; do
+    (( 8 <= cores )) || continue
+    run_on 8 8 "$l" 0 "ranks_$l"
   done
 } | tee "$out/ranks.txt"
+
+python3 bench/scaling_model.py "$costs" check "$out/points.txt" | tee "$out/model.txt"
 echo "scaling_device.sh: tables in $out" >&2
