@@ -83,6 +83,19 @@ def predict(c, actors, envs, horizon, ranks, threads, cores=None, nodes=1, lag=0
             "rollout_MBps_per_host": nic_in / 1e6, "cores": min(cores, procs)}
 
 
+def plan(c, envs, horizon, cores, nodes=1, lag=0):
+    """The fastest split of cores x nodes into A actors and L single-thread ranks (A a multiple of
+    L), on cores of their own or sharing them: (A, L, prediction). Ties go to fewer processes."""
+    total = cores * nodes
+    best = None
+    for ranks in range(1, total + 1):
+        for actors in range(ranks, total + 1, ranks):
+            p = predict(c, actors, envs, horizon, ranks, 1, cores=total, nodes=nodes, lag=lag)
+            if best is None or p["fps"] > best[2]["fps"] * (1 + 1e-9):
+                best = (actors, ranks, p)
+    return best
+
+
 def main(argv):
     if len(argv) < 3:
         print(__doc__)
@@ -108,17 +121,11 @@ def main(argv):
         for i, o in enumerate(opts):
             if o in ("--cores", "--nodes", "--lag"):
                 kw[o[2:]] = int(opts[i + 1])
-        total = kw["cores"] * kw["nodes"]
-        best = None
-        for ranks in range(1, total + 1):  # cores of their own (A + L <= C) or shared (A, L <= C)
-            for actors in range(ranks, total + 1, ranks):  # the actors divide among the ranks
-                p = predict(c, actors, envs, horizon, ranks, 1, cores=total, nodes=kw["nodes"], lag=kw["lag"])
-                if best is None or p["fps"] > best[2]["fps"]:
-                    best = (actors, ranks, p)
-        a, l, p = best
+        a, l, p = plan(c, envs, horizon, **kw)
         if "--terse" in opts:  # for scripts: "ACTORS RANKS"
             print(a, l)
             return 0
+        total = kw["cores"] * kw["nodes"]
         print("%d cores x %d nodes, lag %d: %d actors of %d environments and %d learner ranks (%s): fps %.0f (%.2f of the bound %.0f); next bottleneck: %s"
               % (kw["cores"], kw["nodes"], kw["lag"], a, envs, l, "cores of their own" if a + l <= total else "sharing the cores",
                  p["fps"], p["efficiency"], p["bound"], p["next"]))
