@@ -142,180 +142,31 @@ DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
 const ActorTally& RolloutAssembler::actorTally(int actor_id) const {
   static const ActorTally kNone;
   if (actor_id < 0 || actor_id >= static_cast<int>(actors_.size())) return kNone;
-  return actors_[actor_id].tally;
+  return actors_[actor_id].tally();
 }
 
-void RolloutAssembler::closeRollouts(ActorWindow& a, int actor_id, int64_t upto) {
-  int64_t lost = 0;
-  for (int64_t x = std::max(a.closed + 1, a.first); x <= upto; ++x) {
-    const SeenRollout* seen = nullptr;
-    for (const SeenRollout& r : a.rollouts)
-      if (r.seq == x) seen = &r;
-    if (seen == nullptr) {
-      lost += a.num_chunks;  // wholly lost: as many chunks as the actor's last rollout had
-      continue;
-    }
-    int arrived = 0;
-    for (std::size_t i = 0; i < seen->bits.size(); ++i) arrived += std::popcount(seen->bits[i] | seen->arrived[i]);
-    lost += seen->num_chunks - arrived;
-  }
-  a.closed = std::max(a.closed, upto);
-  if (lost == 0) return;
-  a.tally.lost += lost;
+ActorNumbering& RolloutAssembler::numberingOf(int actor_id) {
+  while (static_cast<int>(actors_.size()) <= actor_id) actors_.emplace_back(cfg_.dedup_window, cfg_.loss_horizon);
+  return actors_[actor_id];
+}
+
+void RolloutAssembler::apply(int actor_id, const masa::lcmt_rollout_chunk& m, const ActorNumbering::Change& change) {
   const int r = static_cast<int>(DropReason::kLost);
-  stats_.count[r] += lost;
-  if (warnDue(DropReason::kLost)) {
-    std::cerr << "masa transport: " << lost << " rollout chunk(s) from actor " << actor_id
+  stats_.count[r] += change.lost - change.found;
+  if (change.lost > 0 && warnDue(DropReason::kLost)) {
+    std::cerr << "masa transport: " << change.lost << " rollout chunk(s) from actor " << actor_id
               << " never arrived (network loss, or a receive buffer too small: check net.core.rmem_max)";
     if (suppressed_[r] > 0) std::cerr << "; " << suppressed_[r] << " more such reports not shown";
     std::cerr << "; total lost " << stats_.count[r] << "\n";
     suppressed_[r] = 0;
   }
-}
-
-void RolloutAssembler::startNumbering(ActorWindow& a, int actor_id, int64_t incarnation, int64_t seq) {
-  const bool restart = a.first >= 0;
-  if (restart) closeRollouts(a, actor_id, a.newest);  // the old numbering's last rollouts are final now
-  if (cfg_.warn_interval_s >= 0) {
-    if (restart) {
-      std::cerr << "masa transport: actor " << actor_id << " restarted (incarnation " << incarnation << " after "
-                << a.incarnation << ", at its rollout " << seq << "): a new numbering, not replays\n";
-    } else {
-      std::cerr << "masa transport: actor " << actor_id << " joined\n";
-    }
-  }
-  for (SeenRollout& r : a.rollouts) r.seq = -1;
-  a.incarnation = incarnation;
-  a.first = a.newest = seq;
-  a.closed = seq - 1;
-  ++a.tally.numberings;
-}
-
-RolloutAssembler::ActorWindow& RolloutAssembler::windowOf(int actor_id) {
-  if (static_cast<int>(actors_.size()) <= actor_id) actors_.resize(actor_id + 1);
-  ActorWindow& a = actors_[actor_id];
-  // Twice the window: rollouts up to dedup_window behind the newest, and out-of-date arrivals up
-  // to dedup_window ahead of it.
-  if (a.rollouts.empty()) a.rollouts.resize(2 * cfg_.dedup_window);
-  return a;
-}
-
-RolloutAssembler::SeenRollout* RolloutAssembler::findSlot(ActorWindow& a, int64_t seq) {
-  for (SeenRollout& r : a.rollouts)
-    if (r.seq == seq) return &r;
-  return nullptr;
-}
-
-namespace {
-void resetSlot(auto& slot, int64_t seq, int32_t num_chunks) {
-  slot.seq = seq;
-  slot.num_chunks = num_chunks;
-  slot.bits.assign((num_chunks + 63) / 64, 0);
-  slot.arrived.assign(slot.bits.size(), 0);
-}
-bool anyBit(const std::vector<uint64_t>& bits) {
-  for (uint64_t b : bits)
-    if (b != 0) return true;
-  return false;
-}
-}  // namespace
-
-RolloutAssembler::SeenRollout& RolloutAssembler::claimSlot(ActorWindow& a, int64_t seq, int32_t num_chunks) {
-  // The slots hold at most dedup_window rollouts behind the newest and dedup_window ahead of it, so
-  // the oldest slot is unused or outside the window (its losses already counted).
-  SeenRollout* oldest = &a.rollouts[0];
-  for (SeenRollout& r : a.rollouts)
-    if (r.seq < oldest->seq) oldest = &r;
-  resetSlot(*oldest, seq, num_chunks);
-  return *oldest;
-}
-
-DropReason RolloutAssembler::markAccepted(const masa::lcmt_rollout_chunk& m) {
-  ActorWindow& a = windowOf(m.actor_id);
-  const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
-  if (a.first < 0) startNumbering(a, m.actor_id, m.incarnation, s);  // first sight
-  if (m.incarnation != a.incarnation) return acceptFarChunk(a, m);
-
-  SeenRollout* slot = findSlot(a, s);
-  if (slot == nullptr) {
-    if (s > a.newest + w) return acceptFarChunk(a, m);
-    if (s <= a.newest - w) return DropReason::kDuplicate;  // behind the window: a replay or a straggler we can no longer check
-    if (s > a.newest) {
-      a.candidate.seq = -1;  // the numbering moved on: a far rollout seen before it was not a restart
-      closeRollouts(a, m.actor_id, s - cfg_.loss_horizon);
-      a.newest = s;
-    }
-    slot = &claimSlot(a, s, m.num_chunks);
-  } else if (slot->num_chunks != m.num_chunks) {
-    // Chunks of one rollout disagree on how many there are. Only arrivals of out-of-date chunks
-    // (perhaps hostile) made the slot so far: the first accepted chunk decides.
-    if (anyBit(slot->bits)) return DropReason::kOutOfRange;
-    resetSlot(*slot, s, m.num_chunks);
-  }
-  const std::size_t w64 = m.chunk_index / 64;
-  const uint64_t bit = uint64_t{1} << (m.chunk_index % 64);
-  if (slot->bits[w64] & bit) return DropReason::kDuplicate;
-  const bool first_arrival = !(slot->arrived[w64] & bit);
-  slot->bits[w64] |= bit;
-  a.num_chunks = m.num_chunks;
-  ++a.tally.accepted;
-  if (first_arrival && s <= a.closed && a.tally.lost > 0) {
-    // Arrived after its rollout's losses were counted: it was not lost after all.
-    --a.tally.lost;
-    --stats_.count[static_cast<int>(DropReason::kLost)];
-  }
-  return DropReason::kAccepted;
-}
-
-DropReason RolloutAssembler::acceptFarChunk(ActorWindow& a, const masa::lcmt_rollout_chunk& m) {
-  SeenRollout& c = a.candidate;
-  const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
-  const bool same_candidate = c.seq >= 0 && a.candidate_incarnation == m.incarnation;
-  if (same_candidate && s > c.seq && s <= c.seq + w) {
-    // The far rollout's successor, with no progress of the current numbering in between: a
-    // restarted actor (another incarnation), or an outage that lost the rollouts in the gap.
-    SeenRollout far = std::move(c);
-    c.seq = -1;
-    if (m.incarnation != a.incarnation) {
-      startNumbering(a, m.actor_id, m.incarnation, far.seq);
-    } else {
-      closeRollouts(a, m.actor_id, far.seq - cfg_.loss_horizon);
-      a.newest = far.seq;
-    }
-    a.num_chunks = far.num_chunks;
-    claimSlot(a, far.seq, far.num_chunks) = std::move(far);
-    return markAccepted(m);  // within the window now
-  }
-  if (!same_candidate || c.seq != s || c.num_chunks != m.num_chunks) {  // replaces an unconfirmed one
-    resetSlot(c, s, m.num_chunks);
-    a.candidate_incarnation = m.incarnation;
-  }
-  const std::size_t w64 = m.chunk_index / 64;
-  const uint64_t bit = uint64_t{1} << (m.chunk_index % 64);
-  if (c.bits[w64] & bit) return DropReason::kDuplicate;
-  c.bits[w64] |= bit;
-  ++a.tally.accepted;
-  return DropReason::kAccepted;
-}
-
-void RolloutAssembler::markArrived(const masa::lcmt_rollout_chunk& m) {
-  if (m.actor_id >= static_cast<int>(actors_.size())) return;  // an actor never accepted: nothing to follow
-  ActorWindow& a = actors_[m.actor_id];
-  const int64_t s = m.rollout_seq, w = cfg_.dedup_window;
-  if (a.first < 0 || m.incarnation != a.incarnation || s <= a.newest - w || s > a.newest + w) return;
-  SeenRollout* slot = findSlot(a, s);
-  if (slot == nullptr) {
-    slot = &claimSlot(a, s, m.num_chunks);
-  } else if (slot->num_chunks != m.num_chunks) {
-    return;
-  }
-  const std::size_t w64 = m.chunk_index / 64;
-  const uint64_t bit = uint64_t{1} << (m.chunk_index % 64);
-  if ((slot->bits[w64] | slot->arrived[w64]) & bit) return;
-  slot->arrived[w64] |= bit;
-  if (s <= a.closed && a.tally.lost > 0) {
-    --a.tally.lost;
-    --stats_.count[static_cast<int>(DropReason::kLost)];
+  if (cfg_.warn_interval_s < 0) return;
+  if (change.numbering == ActorNumbering::Change::Numbering::kRestarted) {
+    std::cerr << "masa transport: actor " << actor_id << " restarted (incarnation " << m.incarnation << " after "
+              << change.previous_incarnation << ", at its rollout " << actors_[actor_id].firstRollout()
+              << "): a new numbering, not replays\n";
+  } else if (change.numbering == ActorNumbering::Change::Numbering::kJoined) {
+    std::cerr << "masa transport: actor " << actor_id << " joined\n";
   }
 }
 
@@ -356,12 +207,18 @@ Verdict RolloutAssembler::finish(DropReason reason, const masa::lcmt_rollout_chu
 
 Verdict RolloutAssembler::accept(const masa::lcmt_rollout_chunk& msg) {
   DropReason reason = validate(msg);
+  const ChunkPlace place{msg.incarnation, msg.rollout_seq, msg.num_chunks, msg.chunk_index};
+  ActorNumbering::Change change;
   if (reason == DropReason::kAccepted) {
-    reason = markAccepted(msg);
-  } else if (reason == DropReason::kTooOld || reason == DropReason::kFutureVersion) {
+    reason = numberingOf(msg.actor_id).accept(place, change);
+    apply(msg.actor_id, msg, change);
+  } else if ((reason == DropReason::kTooOld || reason == DropReason::kFutureVersion) &&
+             msg.actor_id < static_cast<int>(actors_.size())) {
     // Well-formed (the version is checked after the sizes and ranges) and merely out of date: it
-    // arrived, so it must not be counted lost. Hostile chunks never mark anything as seen.
-    markArrived(msg);
+    // arrived, so it must not be counted lost. Hostile chunks never mark anything as seen, and an
+    // actor never accepted has nothing to follow.
+    actors_[msg.actor_id].arrived(place, change);
+    apply(msg.actor_id, msg, change);
   }
   return finish(reason, &msg);
 }
