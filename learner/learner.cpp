@@ -48,8 +48,10 @@ int64_t randomRunId() {
   return static_cast<int64_t>(x & 0x7fffffffffffffffULL) | 1;  // positive, never 0
 }
 
-AssemblerConfig assemblerConfig(int64_t run_id, const config::RunConfig& rc, int obs_dim, int act_dim) {
+AssemblerConfig assemblerConfig(int64_t run_id, const config::RunConfig& rc, int obs_dim, int act_dim,
+                                std::vector<std::string> term_names) {
   AssemblerConfig a;
+  a.term_names = std::move(term_names);
   a.run_id = run_id;
   a.horizon = rc.ppo.horizon;
   a.obs_dim = obs_dim;
@@ -97,7 +99,13 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
     run_id_ = ranks_->gather(run_id_)[0];
     checkRanksAgree();
   }
-  assembler_ = std::make_unique<RolloutAssembler>(assemblerConfig(run_id_, rc_, model_->obsDim(), model_->actDim()));
+  // The task says its reward terms; a chunk that names others is dropped (they become column names
+  // and gnuplot words).
+  auto factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc_.task, spec, rc_.env, rc_.origin);
+  const auto probe = factory->create();
+  columns_.term_names = probe->rewardTermNames();
+  assembler_ = std::make_unique<RolloutAssembler>(
+      assemblerConfig(run_id_, rc_, model_->obsDim(), model_->actDim(), columns_.term_names));
   assembler_->setLearnerVersion(updates_);
 
   const std::string intake_url = opt_.rollout_url.empty() ? opt_.url : opt_.rollout_url;
@@ -107,8 +115,6 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
 
   if (isLeadRank()) {
-    auto factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc_.task, spec, rc_.env, rc_.origin);
-    const auto probe = factory->create();
     has_success_ = probe->measuresSuccess();
     if (rc_.runner.eval_every > 0) {
       columns_.progress_names = probe->progressNames();
@@ -170,10 +176,9 @@ void Learner::onChunk(const void* data, int size) {
     c.obs_dim = model_->obsDim();
     c.act_dim = model_->actDim();
     c.max_policy_lag = rc_.ppo.max_policy_lag;
-    c.term_names = m.term_names;
+    c.term_names = columns_.term_names;  // the task's: the assembler dropped chunks naming others
     collector_ = std::make_unique<BatchCollector>(c);
     collector_->setLearnerVersion(updates_);
-    columns_.term_names = m.term_names;
   }
   collector_->add(*v.chunk);
 }

@@ -1,5 +1,6 @@
 #include "learner/learning_curve.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -19,9 +20,11 @@ namespace masa::learner {
 namespace fs = std::filesystem;
 
 std::string gnuplotQuoted(const std::string& s) {
+  // gnuplot runs `command` inside a double-quoted string and expands @macros: only characters that
+  // can do neither pass (names of tasks, methods, terms, titles, labels are all of these).
   std::string out;
   for (char c : s)
-    if (c != '"' && c != '\\' && c != '\n') out += c;
+    if (std::isalnum(static_cast<unsigned char>(c)) || std::strchr(" _-+./:,()[]=%#", c) != nullptr) out += c;
   return '"' + out + '"';
 }
 

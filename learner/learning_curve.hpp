@@ -51,8 +51,8 @@ class LearningCurve {
 std::string curveScriptHeader(const std::string& what, const std::string& writer, const std::string& title,
                               const std::string& xlabel);
 std::string curveScriptFooter();
-// A gnuplot double-quoted string: quotes, backslashes and newlines dropped, so that a title cannot
-// break out of it.
+// A gnuplot double-quoted string of the characters that can neither end it, run a command
+// (`backquotes`) nor expand a macro (@): letters, digits and " _-+./:,()[]=%#"; the rest dropped.
 std::string gnuplotQuoted(const std::string& s);
 
 // gnuplot script text for a metrics.csv with these reward terms (exposed for tests).

@@ -14,6 +14,7 @@ std::string_view dropReasonName(DropReason r) {
     case DropReason::kTooOld: return "too_old";
     case DropReason::kDuplicate: return "duplicate";
     case DropReason::kOutOfRange: return "out_of_range";
+    case DropReason::kWrongTerms: return "wrong_terms";
     case DropReason::kUnauthenticated: return "unauthenticated";
     case DropReason::kLost: return "lost";
     case DropReason::kCount: break;

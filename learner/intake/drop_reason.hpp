@@ -19,6 +19,7 @@ enum class DropReason : int {
   kTooOld,         // policy_version older than current - max_policy_lag
   kDuplicate,      // the same (actor, rollout, chunk) already arrived, or its rollout is too far behind to tell
   kOutOfRange,     // an index or enumerated value out of its range (chunk index, env range, final index, flags)
+  kWrongTerms,     // reward term names other than the task's (they name metrics.csv's columns and the curve's plots)
   // Never a verdict of the assembler: no valid tag of the run key, dropped by the Transport before
   // the assembler sees the bytes (so it moves no actor's state); the learner adds its count.
   kUnauthenticated,

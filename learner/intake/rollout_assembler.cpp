@@ -107,6 +107,7 @@ DropReason RolloutAssembler::validate(const masa::lcmt_rollout_chunk& m) const {
     sizes = sizes && sizeIs(a, m.num_episodes * int64_t{width});
   });
   if (!sizes) return DropReason::kBadLength;
+  if (!cfg_.term_names.empty() && m.term_names != cfg_.term_names) return DropReason::kWrongTerms;
 
   if (m.policy_version > version_) return DropReason::kFutureVersion;
   if (m.policy_version < version_ - cfg_.max_policy_lag) return DropReason::kTooOld;

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "learner/intake/actor_numbering.hpp"
@@ -37,6 +38,10 @@ struct AssemblerConfig {
   int dedup_window = 16;             // rollouts per actor remembered to detect duplicates
   int loss_horizon = 2;              // rollouts an actor must be past a rollout before its gaps count as lost
   double warn_interval_s = 5.0;      // at most one warning per reason per interval; < 0: silent
+  // The task's reward term names: a chunk must carry exactly these (empty: any, for tests of other
+  // things). The learner writes them into metrics.csv's header and the curve's gnuplot script, so
+  // they are never taken from the network.
+  std::vector<std::string> term_names;
 };
 
 // A chunk that passed validation. Only RolloutAssembler makes them, so code that takes one (the

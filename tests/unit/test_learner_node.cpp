@@ -58,7 +58,7 @@ struct FakeActor {
   FakeActor(const config::RunConfig& rc, uint64_t seed) {
     const auto spec = sym::SymmetrySpec::load(rc.spec_path);
     const int E = rc.ppo.num_envs, T = rc.ppo.horizon, od = spec.obsDim(), ad = spec.actDim();
-    rollout.allocate(E, T, od, ad, {"keypoints", "reach"});
+    rollout.allocate(E, T, od, ad, {"keypoints", "reach", "termination"});  // the task's terms
     rollout.clearEvents();
     std::mt19937_64 rng(seed);
     std::normal_distribution<float> normal;
@@ -80,7 +80,7 @@ struct FakeActor {
     std::vector<float> final_obs(od, 0.5f);
     rollout.truncated[rollout.step(1, 2)] = 1;
     rollout.addFinal(1, 2, final_obs.data());
-    const float terms[2] = {1.5f, -0.5f};
+    const float terms[3] = {1.5f, -0.5f, 0.0f};
     rollout.addEpisode(2, 3.0f, 20, 1, terms);
   }
 
@@ -148,7 +148,7 @@ TEST(LearnerNode, OneBatchFromAFakeActorMakesVersionOneAndPublishesParamsStatsAn
   EXPECT_EQ(stats.num_episodes, 1);
   EXPECT_FLOAT_EQ(stats.mean_episode_return, 3.0f);
   EXPECT_FLOAT_EQ(stats.success_rate, 1.0f);
-  ASSERT_EQ(stats.num_terms, 2);
+  ASSERT_EQ(stats.num_terms, 3);
   EXPECT_EQ(stats.term_names[0], "keypoints");
   EXPECT_FLOAT_EQ(stats.term_means[1], -0.5f);
   EXPECT_TRUE(std::isfinite(stats.actor_loss) && std::isfinite(stats.critic_loss));

@@ -131,5 +131,25 @@ TEST(LearningCurve, WithoutGnuplotTheRenderReportsFailureAndTrainingGoesOn) {
   fs::remove_all(dir);
 }
 
+// docs/inputs.md gap 1: gnuplot runs `commands` inside double-quoted strings and expands @macros;
+// whatever a name holds, the script carries neither, and rendering runs nothing.
+TEST(LearningCurve, NamesCannotRunACommandOrAMacroInTheScript) {
+  const fs::path marker = fs::temp_directory_path() / "masa_gnuplot_injected";
+  fs::remove(marker);
+  const std::string evil = "`touch " + marker.string() + "`";
+  const std::string script = learningCurveScript("a1_beam / masa @evil \" \\ $x", {evil, "alive"}, false);
+  EXPECT_EQ(script.find('`'), std::string::npos) << script;
+  EXPECT_EQ(script.find("@evil"), std::string::npos);
+  EXPECT_EQ(gnuplotQuoted("a1_beam / masa, seed 7 (x1.5) [10%]"), "\"a1_beam / masa, seed 7 (x1.5) [10%]\"")
+      << "ordinary titles pass unchanged";
+  if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
+  const fs::path dir = freshDir("injection");
+  writeMetrics(dir, 4);
+  LearningCurve curve(dir.string(), "a1_beam / masa", {evil, "alive"}, false);
+  curve.renderAndWait();
+  EXPECT_FALSE(fs::exists(marker)) << "gnuplot ran the name's command";
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace masa::learner

@@ -407,5 +407,32 @@ TEST(RolloutAssembler, MalformedBytesAreDroppedWithoutDecodingHostileLengths) {
   EXPECT_TRUE(v) << dropReasonName(v.reason);
 }
 
+// docs/inputs.md gap 1: term names become metrics.csv's columns and words of the curve's gnuplot
+// script; a chunk naming others than the task's (a backquoted command, a comma) is dropped as
+// wrong_terms, moves nothing, and the chunk with the task's names still goes through.
+TEST(RolloutAssembler, AChunkNamingOtherRewardTermsThanTheTasksIsDropped) {
+  const auto chunks = makeChunks(5);
+  const masa::lcmt_rollout_chunk& good = chunks[0];
+  ASSERT_FALSE(good.term_names.empty());
+  AssemblerConfig config = assemblerConfig(1);
+  config.term_names = good.term_names;
+  RolloutAssembler assembler(config);
+  assembler.setLearnerVersion(5);
+  for (const std::string name : std::vector<std::string>{"`touch /tmp/masa_pwned`", "alive,reward", "other"}) {
+    masa::lcmt_rollout_chunk bad = good;
+    bad.term_names[0] = name;
+    const Verdict v = assembler.accept(bad);
+    EXPECT_EQ(v.reason, DropReason::kWrongTerms) << name << ": " << dropReasonName(v.reason);
+    EXPECT_FALSE(v.chunk.has_value());
+  }
+  masa::lcmt_rollout_chunk reordered = good;
+  if (reordered.term_names.size() > 1) {
+    std::swap(reordered.term_names[0], reordered.term_names[1]);
+    EXPECT_EQ(assembler.accept(reordered).reason, DropReason::kWrongTerms) << "the order names the columns too";
+  }
+  EXPECT_TRUE(assembler.accept(good)) << "nothing of the dropped ones marked the chunk as seen";
+  EXPECT_EQ(assembler.stats()[DropReason::kWrongTerms], reordered.term_names.size() > 1 ? 4 : 3);
+}
+
 }  // namespace
 }  // namespace masa::transport
