@@ -48,6 +48,10 @@ while [ $# -gt 0 ]; do
   esac
 done
 
+for pair in "--actors:$actors" "--envs:$envs" ${updates:+"--updates:$updates"} "--ranks:$ranks"; do
+  [[ ${pair#*:} =~ ^[1-9][0-9]*$ ]] || { echo "train.sh: ${pair%%:*} '${pair#*:}' is not a positive count" >&2; exit 2; }
+done
+
 build=${MASA_BUILD_DIR:-build}
 for bin in "$build/learner/masa_learner" "$build/actors/masa_actor" "$build/tools/masa_config"; do
   [ -x "$bin" ] || { echo "train.sh: $bin is missing: run scripts/build.sh first" >&2; exit 2; }
@@ -80,7 +84,6 @@ fi
 # Data-parallel learner ranks: the job a cluster runs (every process takes its role, actor id, URL
 # and the run key from the MPI job, docs/scaling.md), here on this machine, so one machine and many
 # share one role logic. One rank (the default) is the plain learner below and needs no MPI.
-[[ $ranks =~ ^[1-9][0-9]*$ ]] || { echo "train.sh: --ranks '$ranks' is not a positive count" >&2; exit 2; }
 if [ "$ranks" -gt 1 ]; then
   [ -z "$hosts_file" ] || { echo "train.sh: --ranks with --hosts: on several machines use deploy/cluster/mpirun_train.sh --hostfile or deploy/cluster/slurm_train.sbatch" >&2; exit 2; }
   command -v "${MASA_MPIRUN:-mpirun}" > /dev/null ||

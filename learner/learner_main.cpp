@@ -69,7 +69,8 @@ int main(int argc, char** argv) {
   url = masa::transport::loopbackUrl();
   app.add_option("--url", url, "LCM provider URL")->capture_default_str();
   app.add_option("--run-id", run_id, "run id actors must carry (default: random, or the checkpoint's)");
-  app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_updates)");
+  app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_updates)")
+      ->check(CLI::NonNegativeNumber);
   std::string key_file;
   bool no_auth = false;
   auto* key_opt = app.add_option("--key-file", key_file,

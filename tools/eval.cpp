@@ -154,9 +154,9 @@ int main(int argc, char** argv) {
   app.add_option("--film-episode", film_episode, "which episode to film (its seed is seed + this)")->capture_default_str();
   app.add_option("--label", label, "text at the start of every filmed frame's caption (e.g. the method and seed)");
   app.add_option("--strip-frames", strip, "frames in a .png strip")->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--fps", fps, "video frame rate")->capture_default_str();
-  app.add_option("--width", width, "video width")->capture_default_str();
-  app.add_option("--height", height, "video height")->capture_default_str();
+  app.add_option("--fps", fps, "video frame rate")->capture_default_str()->check(CLI::Range(1, 1000));
+  app.add_option("--width", width, "video width")->capture_default_str()->check(CLI::Range(16, 8192));
+  app.add_option("--height", height, "video height")->capture_default_str()->check(CLI::Range(16, 8192));
   app.add_option("--camera-distance", camera_distance, "camera distance in m (default: from the model's size)");
   CLI11_PARSE(app, argc, argv);
   o.deterministic = !sample;

@@ -97,8 +97,9 @@ int main(int argc, char** argv) {
   app.add_option("--url", url, "LCM provider URL")->capture_default_str();
   app.add_option("--channel", channels, "channel to listen on (repeatable; default MASA_POLICY)");
   app.add_flag("--all", all, "listen on all four masa channels");
-  app.add_option("--duration", duration_s, "stop after this many seconds (0: until Ctrl-C or --count)");
-  app.add_option("--count", max_count, "stop after this many messages in all (0: no limit)");
+  app.add_option("--duration", duration_s, "stop after this many seconds (0: until Ctrl-C or --count)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--count", max_count, "stop after this many messages in all (0: no limit)")->check(CLI::NonNegativeNumber);
   app.add_option("--run-id", run_id, "count only messages of this run (0: any run)");
   app.add_option("--csv", csv_path, "write one row per message: channel,recv_us,utime,latency_us,bytes,version");
   app.add_flag("--quiet", quiet, "print the summary only, not one line per message");

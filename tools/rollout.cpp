@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   bool deterministic = false;
   app.add_option("--task", task_name, "task name")->capture_default_str();
   app.add_option("--set", overrides, "config override key.path=value (repeatable)");
-  app.add_option("--episodes", episodes, "episodes to run")->capture_default_str();
+  app.add_option("--episodes", episodes, "episodes to run")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "seed of resets and random actions")->capture_default_str();
   app.add_option("--checkpoint", checkpoint, "model file saved by masa (default: uniform random actions)");
   app.add_flag("--deterministic", deterministic, "act with the policy mean instead of sampling");

@@ -29,8 +29,8 @@ int main(int argc, char** argv) {
   app.add_option("--model", model_file, "an MJCF file of your own robot (with --spec)");
   app.add_option("--spec", spec_file, "symmetry spec (default: the task's)");
   app.add_option("--set", overrides, "config override key.path=value (repeatable)");
-  app.add_option("--states", opt.num_states, "random states to test")->capture_default_str();
-  app.add_option("--steps", opt.steps, "steps compared from each state")->capture_default_str();
+  app.add_option("--states", opt.num_states, "random states to test")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--steps", opt.steps, "steps compared from each state")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--seed", opt.seed, "seed of the random states and actions")->capture_default_str();
   app.add_option("--tolerance", opt.tolerance, "largest error that passes")->capture_default_str();
   app.add_option("--top", top, "how many worst entries and joints to list")->capture_default_str();

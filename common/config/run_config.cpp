@@ -1,8 +1,10 @@
 #include "common/config/run_config.hpp"
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <sstream>
+#include <type_traits>
 
 #include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
@@ -113,11 +115,17 @@ class Reader {
   template <typename T>
   T get(const std::string& path, const char* what) const {
     const YAML::Node n = node(path);
+    T v;
     try {
-      return n.as<T>();
+      v = n.as<T>();
     } catch (const YAML::Exception&) {
       throw ConfigError(originOf(path), path, std::string("expected ") + what + ", got '" + YAML::Dump(n) + "'");
     }
+    // YAML spells NaN and infinity (.nan, .inf); no setting of a run means either.
+    if constexpr (std::is_floating_point_v<T>) {
+      if (!std::isfinite(v)) throw ConfigError(originOf(path), path, "expected a finite number, got '" + YAML::Dump(n) + "'");
+    }
+    return v;
   }
   double positive(const std::string& path) const {
     const double v = get<double>(path, "a number");

@@ -1,5 +1,7 @@
 #include "common/sim/env_params.hpp"
 
+#include <cmath>
+
 #include <sstream>
 
 #include "common/core/config_error.hpp"
@@ -39,11 +41,15 @@ double EnvParams::number(const std::string& key, double fallback) {
   asked_.insert(key);
   const YAML::Node n = lookup(key);
   if (!n.IsDefined() || n.IsNull()) return fallback;
+  double v = 0;
   try {
-    return n.as<double>();
+    v = n.as<double>();
   } catch (const YAML::Exception&) {
     throw ConfigError(originOf(key), "env." + key, "expected a number, got '" + YAML::Dump(n) + "'");
   }
+  // YAML spells NaN and infinity (.nan, .inf): a reward weight or a gain of either poisons a run.
+  if (!std::isfinite(v)) throw ConfigError(originOf(key), "env." + key, "expected a finite number, got '" + YAML::Dump(n) + "'");
+  return v;
 }
 
 double EnvParams::positive(const std::string& key, double fallback) {

@@ -116,7 +116,8 @@ int main(int argc, char** argv) {
   app.add_option("--config", config_file, "the robot's deploy config (YAML; keys of configs/deploy/defaults.yaml)");
   app.add_option("--set", sets, "key.path=value over the config (repeatable)");
   app.add_option("--url", url, "LCM provider URL (overrides lcm.url)");
-  app.add_option("--duration", duration_s, "stop (with the safe command) after this many seconds (0: until Ctrl-C)");
+  app.add_option("--duration", duration_s, "stop (with the safe command) after this many seconds (0: until Ctrl-C)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--max-policy-steps", max_policy_steps, "hold the pose and stop after this many policy commands");
   app.add_flag("--exit-on-trip", exit_on_trip, "exit (code 4) once the watchdog or the emergency stop has tripped and its command is out");
   app.add_flag("--quiet", quiet, "no per-second status line");

@@ -59,7 +59,8 @@ int main(int argc, char** argv) {
   bool quiet = false;
   app.add_option("policy", policy_path, "policy file: its task is built exactly as trained")->required()->check(CLI::ExistingFile);
   app.add_option("--seed", seed, "the task resets from this seed (masa_eval's episode 0 of --seed)")->capture_default_str();
-  app.add_option("--duration", duration, "seconds of simulated time after the first command")->capture_default_str();
+  app.add_option("--duration", duration, "seconds of simulated time after the first command")->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--state-every", state_every, "publish state every N physics steps")->capture_default_str()->check(CLI::Range(1, 1000));
   app.add_option("--delay-ms", delay_ms, "command delay")->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--jitter-ms", jitter_ms, "extra command delay, uniform in [0, jitter]")->capture_default_str()->check(CLI::NonNegativeNumber);

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "common/config/run_config.hpp"
+#include "common/core/config_error.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/sim/policy_evaluator.hpp"
 #include "tasks/tasks.hpp"
@@ -92,6 +93,22 @@ TEST(PolicyFile, AMasaPolicyWhoseSpecWasSwappedFailsTheEquivarianceCheckOnLoad) 
   mean[0] = 3.0f;  // trunk_y is odd under the mirror: a non-zero mean breaks the symmetry
   p.model->obsNormalizer().setMeanStd(mean.data(), std.data());
   EXPECT_THROW(checkPolicySymmetry(p), std::runtime_error);
+}
+
+// docs/inputs.md gap 3: an env setting of NaN or infinity (a reward weight, a gain) is refused
+// when the task is built, naming the key.
+TEST(TaskFactory, ANaNOrInfiniteEnvSettingIsRefusedNamingTheKey) {
+  for (const std::string v : {".nan", ".inf"}) {
+    try {
+      const auto rc = config::loadRunConfig(config::defaultConfigsDir(), {"task=a1_beam", "env.weights.velocity=" + v});
+      const auto spec = sym::SymmetrySpec::load(rc.spec_path);
+      task::TaskFactory(task::taskCatalog(), rc.task, spec, rc.env, rc.origin).create();
+      ADD_FAILURE() << "env.weights.velocity=" << v << " was taken";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), "env.weights.velocity");
+      EXPECT_NE(std::string(e.what()).find("finite"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(PolicyEvaluator, EpisodesDependOnTheirSeedsOnlyNotOnTheBatchOrThreads) {

@@ -117,6 +117,19 @@ TEST_F(ScratchConfigs, UnknownKeyOnCommandLineNamesCommandLine) {
   EXPECT_EQ(e.key(), "ppo.horizn");
 }
 
+// docs/inputs.md gap 3: YAML spells NaN and infinity (.nan, .inf); a run setting of either used
+// to be taken (the rollout then returned nan).
+TEST_F(ScratchConfigs, NaNOrInfinityIsRefusedNamingTheKey) {
+  writeTask("t", "");
+  for (const std::string v : {".nan", ".inf", "-.inf"}) {
+    const ConfigError e = expectError({"task=t", "model.init_log_std=" + v});
+    EXPECT_EQ(e.key(), "model.init_log_std") << v;
+    EXPECT_NE(std::string(e.what()).find("finite"), std::string::npos) << e.what();
+  }
+  const ConfigError lr = expectError({"task=t", "ppo.learning_rate=.inf"});  // positive() let infinity through
+  EXPECT_EQ(lr.key(), "ppo.learning_rate");
+}
+
 TEST_F(ScratchConfigs, WrongTypeNamesWhereTheValueCameFrom) {
   const std::string file = writeTask("t", "ppo:\n  horizon: lots\n");
   const ConfigError e = expectError({"task=t"});
