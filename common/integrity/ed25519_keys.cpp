@@ -114,7 +114,21 @@ bool TrustedKeys::contains(const PublicKeyBytes& key) const {
   return std::find(keys_.begin(), keys_.end(), key) != keys_.end();
 }
 
+namespace {
+// Anyone who can write a trusted key file, or the directory of them, can make their own key
+// trusted: refuse either, as ssh refuses an authorized_keys others may write.
+void refuseWritableByOthers(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || (st.st_mode & 022) == 0) return;
+  char mode[8];
+  std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+  throw std::runtime_error(path + ": others may write it (mode " + mode +
+                           "), so anyone could add a key that is then trusted (chmod go-w " + path + ")");
+}
+}  // namespace
+
 TrustedKeys TrustedKeys::load(const std::string& path) {
+  refuseWritableByOthers(path);
   std::vector<std::string> files;
   if (fs::is_directory(path)) {
     for (const auto& entry : fs::directory_iterator(path))
@@ -126,6 +140,7 @@ TrustedKeys TrustedKeys::load(const std::string& path) {
   TrustedKeys trusted;
   trusted.source_ = path;
   for (const std::string& f : files) {
+    refuseWritableByOthers(f);
     Bio bio(BIO_new_file(f.c_str(), "r"), &BIO_free);
     if (!bio) throw std::runtime_error(f + ": cannot open the trusted public key file");
     int in_file = 0;

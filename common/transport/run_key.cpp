@@ -82,12 +82,14 @@ RunKey readRunKey(const std::string& path) {
     if (hi < 0 || lo < 0) throw keyError(path, "not hex digits at character " + std::to_string(2 * i + 1));
     k.bytes[i] = static_cast<uint8_t>(hi << 4 | lo);
   }
+  // Whoever reads the key can sign as the run: refuse a key others may read (as ssh refuses a
+  // private key), as the Ed25519 private keys are.
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && (st.st_mode & 077) != 0) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
-    std::cerr << "masa: warning: run key " << path << " has mode " << mode
-              << ": others may read it and forge this run's messages (chmod 600 " << path << ")\n";
+    throw keyError(path, std::string("has mode ") + mode + ": others may read it and forge this run's messages (chmod 600 " +
+                             path + ")");
   }
   return k;
 }

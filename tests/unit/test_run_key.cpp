@@ -60,10 +60,25 @@ TEST(RunKey, UpperCaseHexReadsAsTheSameKey) {
   const std::string lower = (dir / "lower.key").string(), upper = (dir / "upper.key").string();
   std::ofstream(lower) << std::string(32, 'a') << std::string(32, '7') << "\n";
   std::ofstream(upper) << std::string(32, 'A') << std::string(32, '7');
+  fs::permissions(lower, fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
+  fs::permissions(upper, fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
   const RunKey k = readRunKey(lower);
   EXPECT_EQ(k.bytes[0], 0xaa);
   EXPECT_EQ(k.bytes[31], 0x77);
   EXPECT_EQ(readRunKey(upper), k);
+  fs::remove_all(dir);
+}
+
+// docs/inputs.md gap 9: a run key others may read was only warned about; it is refused now.
+TEST(RunKey, AKeyOthersMayReadIsRefusedSayingHowToFixIt) {
+  const fs::path dir = freshDir("mode");
+  const std::string path = (dir / "run.key").string();
+  readOrCreateRunKey(path);
+  fs::permissions(path, fs::perms::others_read, fs::perm_options::add);
+  EXPECT_NE(errorOf(path).find("has mode 0604: others may read it"), std::string::npos) << errorOf(path);
+  EXPECT_NE(errorOf(path).find("chmod 600 " + path), std::string::npos);
+  fs::permissions(path, fs::perms::others_read, fs::perm_options::remove);
+  EXPECT_EQ(errorOf(path), "") << "mode 0600 reads";
   fs::remove_all(dir);
 }
 

@@ -165,6 +165,21 @@ TEST(SealedFile, KeysAreFilesThatAreNeverOverwrittenAndAPrivateKeyOthersMayReadI
   }
   std::ofstream(dir / "junk.pub") << "not a key\n";
   EXPECT_THROW(TrustedKeys::load((dir / "junk.pub").string()), std::runtime_error);
+  // docs/inputs.md gap 9: whoever may write a trusted key, or their directory, could add their own.
+  EXPECT_NO_THROW(TrustedKeys::load((dir / "a.pub").string()));
+  fs::remove(dir / "junk.pub");
+  fs::permissions(dir / "a.pub", fs::perms::others_write, fs::perm_options::add);
+  for (const fs::path& p : {dir / "a.pub", dir}) {
+    try {
+      TrustedKeys::load(p.string());
+      ADD_FAILURE() << "a trusted key others may write was loaded from " << p;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("others may write it"), std::string::npos) << e.what();
+    }
+  }
+  fs::permissions(dir / "a.pub", fs::perms::others_write, fs::perm_options::remove);
+  fs::permissions(dir, fs::perms::group_write, fs::perm_options::add);
+  EXPECT_THROW(TrustedKeys::load(dir.string()), std::runtime_error) << "a directory others may write";
 }
 
 // Random damage of every kind: no crash, and nothing but the intact bytes accepted.
