@@ -155,8 +155,19 @@ EOF
   [ "${dropped:-0}" -gt 0 ] || fail "nftables dropped nothing: the fault was not injected"
   lost=$(sed -n 's/^masa_learner: rollout chunks accepted.*, lost \([0-9][0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
   [ -n "$lost" ] && [ "$lost" -gt 0 ] || fail "nftables dropped $dropped datagrams but the learner counted no lost chunk"
+  repaired=""
+  if [ "$everywhere" = 1 ]; then
+    # Parameters were lost on their way to the actor hosts, and the learner repeated them for the
+    # actors that had not acknowledged them, instead of leaving them to its periodic republish.
+    to_actors=$(( $(dropped_datagrams) - $(ip netns exec "$ns_l" nft list chain inet masa_test input | sed -n 's/.*counter packets \([0-9]*\).*/\1/p') ))
+    [ "$to_actors" -gt 0 ] || fail "nftables dropped nothing on the actor hosts: the parameters' loss was not injected"
+    repeats=$(sed -n 's/^masa_learner: parameter broadcasts repeated for actors that had not acknowledged them \([0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
+    [ -n "$repeats" ] && [ "$repeats" -gt 0 ] ||
+      fail "$to_actors datagrams to the actor hosts were dropped, but the learner repeated no parameters for an actor that had not acknowledged them"
+    repaired=", $to_actors of them on the actor hosts, the learner repeated its parameters $repeats times"
+  fi
   wait_until 15 "the remote actors to stop after the run" no_actor_left
-  echo "PASS: 12 updates over the namespace LAN with $drop% random loss; nftables dropped $dropped datagrams, the learner counted $lost lost chunks"
+  echo "PASS: 12 updates over the namespace LAN with $drop% random loss$([ "$everywhere" = 1 ] && echo " on every host" || true); nftables dropped $dropped datagrams$repaired, the learner counted $lost lost chunks"
   rm -rf "$work"
   exit 0
 fi
