@@ -127,6 +127,7 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
   if (m.version == newest) {  // the learner's periodic repeat: it is alive, and agrees with us
     last_learner_s_ = nowSeconds();
     behind_in_a_row_ = 0;
+    acknowledge_ = true;  // our acknowledgement may have been lost: the learner repeats until it hears one
     return;
   }
   const bool behind = m.version < newest;
@@ -158,6 +159,7 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
   pending_version_ = m.version;
   pending_has_norm_ = m.obs_dim > 0;
   last_learner_s_ = nowSeconds();
+  acknowledge_ = true;
 }
 
 void Actor::rejectParams(int64_t version, const std::string& why) {
@@ -201,13 +203,16 @@ void Actor::publishHeartbeat() {
   hb.steps_per_second = (dt > 0.0 && dt < 1e9) ? static_cast<float>(steps_since_heartbeat_ / dt) : 0.0f;
   hb.policy_version = version_;
   hb.rollouts_sent = rollouts_sent_;
+  hb.params_version = std::max(version_, pending_version_);
   sender().publish(transport::kHeartbeatChannel, hb);
   last_heartbeat_s_ = now;
   steps_since_heartbeat_ = 0;
+  acknowledge_ = false;
 }
 
 void Actor::maybeHeartbeat() {
-  if (nowSeconds() - last_heartbeat_s_ >= options_.heartbeat_interval_s) publishHeartbeat();
+  // At once when parameters came: the learner repeats them until this actor acknowledges them.
+  if (acknowledge_ || nowSeconds() - last_heartbeat_s_ >= options_.heartbeat_interval_s) publishHeartbeat();
 }
 
 double Actor::awaitLimitSeconds() const {

@@ -185,6 +185,9 @@ class Actor {
   int64_t params_rejected_ = 0;
   int64_t rejects_since_warning_ = 0;
   int behind_in_a_row_ = 0;  // valid parameters below our version since the last at it
+  // Parameters at or above our newest version came: the next heartbeat goes out at once, and
+  // acknowledges them (lcmt_actor_heartbeat.params_version).
+  bool acknowledge_ = false;
   double last_reject_warning_s_ = -1e300;
 
   int64_t rollouts_sent_ = 0;

@@ -32,6 +32,10 @@ namespace {
 // RunningMeanStd's default epsilon: the broadcast std is sqrt(var + eps), what the learner divides by.
 constexpr double kObsEps = 1e-5;
 
+// An actor counts as live for the parameter repeats this long after it was last heard: three of its
+// heartbeats (one a second). A dead actor costs the repeats of these seconds, then none.
+constexpr double kActorLiveS = 3.0;
+
 
 model::ModelConfig modelConfigOf(const config::RunConfig& rc) {
   model::ModelConfig m = rc.model;
@@ -68,6 +72,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
       dir_(options.run_dir),
       rng_(rc.seed),
       round_(rc.runner.loss_grace_s),
+      delivery_(rc.runner.repeat_unacknowledged_s, rc.runner.republish_every_s, kActorLiveS),
       ranks_(options.ranks ? options.ranks : &cluster::soloCommunicator()),
       rank_envs_(rc.ppo.num_envs / ranks_->size()) {
   MASA_CHECK(!dir_.empty(), "learner: no run directory");
@@ -113,6 +118,11 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   if (isLeadRank() && intake_url != opt_.url)
     policy_transport_ = std::make_unique<transport::Transport>(opt_.url, opt_.run_key);
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
+  // Actors acknowledge parameters in their heartbeats, which come with their rollouts (rank 0
+  // hears its own actors: the others' heartbeats go to their ranks).
+  if (isLeadRank())
+    transport_->subscribe<masa::lcmt_actor_heartbeat>(transport::kHeartbeatChannel,
+                                                      [this](const masa::lcmt_actor_heartbeat& m) { onHeartbeat(m); });
 
   if (isLeadRank()) {
     has_success_ = probe->measuresSuccess();
@@ -181,13 +191,24 @@ void Learner::onChunk(const void* data, int size) {
     collector_->setLearnerVersion(updates_);
   }
   collector_->add(*v.chunk);
+  delivery_.actorHolds(m.actor_id, m.policy_version, now);  // it acted with that version
+}
+
+void Learner::onHeartbeat(const masa::lcmt_actor_heartbeat& m) {
+  // Authenticated and guarded by the transport; what it says is believed only within bounds. A
+  // heartbeat moves nothing but the repeats of the parameters.
+  if (m.run_id != run_id_ || m.actor_id < 0 || m.actor_id >= assembler_->config().max_actors) return;
+  if (m.params_version < -1) return;
+  delivery_.actorHolds(m.actor_id, m.params_version, std::chrono::steady_clock::now());
 }
 
 int Learner::waitMs(int timeout_ms) const {
-  if (!collector_ || collector_->ready() || collector_->bufferedEnvs() < min_batch_envs_) return timeout_ms;
-  const auto due = round_.nextDeadline();
+  const auto now = std::chrono::steady_clock::now();
+  auto due = std::chrono::steady_clock::time_point::max();
+  if (collector_ && !collector_->ready() && collector_->bufferedEnvs() >= min_batch_envs_) due = round_.nextDeadline();
+  if (isLeadRank()) due = std::min(due, delivery_.nextRepeat(now));
   if (due == std::chrono::steady_clock::time_point::max()) return timeout_ms;
-  const double ms = std::chrono::duration<double, std::milli>(due - std::chrono::steady_clock::now()).count();
+  const double ms = std::chrono::duration<double, std::milli>(due - now).count();
   return static_cast<int>(std::clamp(std::ceil(ms), 0.0, static_cast<double>(timeout_ms)));
 }
 
@@ -238,8 +259,14 @@ bool Learner::step(int timeout_ms) {
     }
   }
   const auto now = std::chrono::steady_clock::now();
-  if (isLeadRank() && std::chrono::duration<double>(now - last_publish_).count() >= rc_.runner.republish_every_s)
-    publishParams();
+  if (isLeadRank()) {
+    if (std::chrono::duration<double>(now - last_publish_).count() >= rc_.runner.republish_every_s) {
+      publishParams();
+    } else if (delivery_.repeatDue(now)) {
+      ++unacknowledged_repeats_;
+      publishParams();
+    }
+  }
   if (auto warning = silence_->check(now, updates_, droppedChunks())) std::cerr << *warning << "\n";
   return updated;
 }
@@ -362,6 +389,7 @@ void Learner::publishParams() {
   }
   publisher().publish(transport::kPolicyChannel, m);
   last_publish_ = std::chrono::steady_clock::now();
+  delivery_.published(m.version, last_publish_);
 }
 
 void Learner::writeCheckpoint() {

@@ -31,10 +31,12 @@
 #include "learner/intake/rollout_assembler.hpp"
 #include "learner/intake/round_tracker.hpp"
 #include "learner/learning_curve.hpp"
+#include "learner/params_delivery.hpp"
 #include "learner/update_report.hpp"
 #include "learner/ppo/ppo_trainer.hpp"
 #include "learner/ppo/rollout_buffer.hpp"
 #include "learner/silence_watch.hpp"
+#include "masa/lcmt_actor_heartbeat.hpp"
 
 namespace masa::learner {
 
@@ -106,11 +108,15 @@ class Learner {
   // Data-parallel ranks: how many ranks heard no rollout data for runner.rank_silence_stop_s and so
   // stopped the run (0: it was not stopped that way).
   int silentRanksAtStop() const { return silent_ranks_at_stop_; }
+  // Parameter broadcasts repeated because a live actor had not acknowledged them (params_delivery.hpp).
+  int64_t unacknowledgedRepeats() const { return unacknowledged_repeats_; }
   const UpdateReport& lastReport() const { return report_; }
 
  private:
   void onChunk(const void* data, int size);
-  // How long step() may wait for traffic: at most timeout_ms, less when a short batch comes due sooner.
+  void onHeartbeat(const masa::lcmt_actor_heartbeat& m);
+  // How long step() may wait for traffic: at most timeout_ms, less when a short batch or a repeat
+  // of the parameters comes due sooner.
   int waitMs(int timeout_ms) const;
   void update();
   // Every rank's parameters, normalizers and learning rate hash the same, or RankDisagreement.
@@ -147,6 +153,8 @@ class Learner {
   std::unique_ptr<BatchCollector> collector_;
   RoundTracker round_;   // when a batch may form short of lost chunks
   int min_batch_envs_;   // the fewest environments a short batch may have (> ppo.num_envs: never short)
+  ParamsDelivery delivery_;  // which live actors hold the newest parameters (rank 0)
+  int64_t unacknowledged_repeats_ = 0;
 
   int64_t updates_ = 0, env_steps_ = 0;
   double wall_offset_s_ = 0;  // wall time of the runs before a resume

@@ -345,6 +345,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
     throw ConfigError(r.originOf("runner.min_batch_fraction"), "runner.min_batch_fraction",
                       "must be in (0, 1], got " + std::to_string(u.min_batch_fraction));
   u.loss_grace_s = r.positive("runner.loss_grace_s");
+  u.repeat_unacknowledged_s = r.nonNegative("runner.repeat_unacknowledged_s");
 
   rc.env = YAML::Clone(merged["env"]);
   rc.resolved = merged;

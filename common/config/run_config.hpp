@@ -56,6 +56,10 @@ struct RunnerConfig {
   // is known lost (learner/intake/round_tracker.hpp); 1: batches are always full.
   double min_batch_fraction = 0.5;
   double loss_grace_s = 0.01;  // seconds after a rollout's latest chunk before its missing ones count as lost
+  // Seconds after a parameter broadcast before it is repeated for a live actor that has not
+  // acknowledged it (learner/params_delivery.hpp), then 1.5x longer each time up to
+  // republish_every_s; 0: only the periodic republish.
+  double repeat_unacknowledged_s = 0.05;
 };
 
 struct RunConfig {

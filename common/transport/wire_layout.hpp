@@ -55,6 +55,7 @@ struct WireLayoutOf<masa::lcmt_actor_heartbeat> {
       {"run_id", WireType::kInt64},   {"actor_id", WireType::kInt32},        {"utime", WireType::kInt64},
       {"hostname", WireType::kString}, {"num_envs", WireType::kInt32},       {"steps_per_second", WireType::kFloat},
       {"policy_version", WireType::kInt64}, {"rollouts_sent", WireType::kInt64},
+      {"params_version", WireType::kInt64},
   };
 };
 

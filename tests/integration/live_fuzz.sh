@@ -6,7 +6,8 @@
 #     run still makes its updates, no process dies, every process exits cleanly, the learner's
 #     parameters stay finite (its policy file loads, its MASA equivariance is checked on load, and
 #     an episode with it is finite), and the copies are counted (malformed chunks at the learner,
-#     rejected parameter messages at the actors; heartbeats and stats have no subscriber here).
+#     rejected parameter messages at the actors; the learner reads heartbeats as acknowledgements of
+#     its parameters, through the same guard; stats have no subscriber here).
 #  2. With the run key, every copy fails its tag: the learner accepts no chunk the actors did not
 #     send, and counts the fuzzed chunks as unauthenticated.
 #   MASA_BUILD_DIR=build bash tests/integration/live_fuzz.sh [PORT]

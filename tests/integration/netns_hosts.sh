@@ -10,19 +10,26 @@
 #      pipe closes: see deploy/tethered.sh).
 # With --drop P, instead: nftables on the learner's host drops P% of the inbound rollout datagrams
 # at random; training must not stall (12 updates), and the learner must count the lost chunks.
+# With --drop P --everywhere: nftables on every host drops P% of every UDP datagram of the run that
+# reaches it from another host (rollouts, parameters, heartbeats), as a lossy switch or Wi-Fi does;
+# training must still reach its end.
+# With --full-model, the runs with loss use the default networks ([400, 200, 100]: a 215 KB parameter
+# message, 4 LCM fragments) and 2 actors x 32 environments, the configuration of issue #33.
 # With --measure N (bench/e2e_loss.sh), instead: N updates with --drop P% loss (0 allowed), and a
 # last line "MEASURE: drop P% ... updates_per_minute X" over the updates after the first 5.
-#   MASA_BUILD_DIR=build bash tests/integration/netns_hosts.sh [--port PORT] [--drop PERCENT] [--measure N]
+#   MASA_BUILD_DIR=build bash tests/integration/netns_hosts.sh [--port PORT] [--drop PERCENT] [--everywhere] [--full-model] [--measure N]
 # Needs root and `ip netns` (and nft for --drop); otherwise it prints SKIP and exits 77.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 source tests/integration/lib.sh
 
-port=7673 drop=0 measure=0
+port=7673 drop=0 measure=0 everywhere=0 full_model=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --port) port=$2; shift 2 ;;
     --drop) drop=$2; shift 2 ;;
+    --everywhere) everywhere=1; shift ;;
+    --full-model) full_model=1; shift ;;
     --measure) measure=$2; shift 2 ;;
     *) echo "netns_hosts.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -76,31 +83,55 @@ setup_network() {
 if ! err=$(setup_network 2>&1); then skip "cannot build network namespaces here: $err"; fi
 log "namespaces: learner $ns_l, actor hosts $ns_a and $ns_b, bridge in $ns_br; $url (work dir $work)"
 
-printf '# actor hosts of this test\n%s 1 8\n%s   # one actor, --envs environments\n' "$ns_a" "$ns_b" > "$work/hosts"
+envs=8 model=(--set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.minibatch_size=256)
+[ "$full_model" = 1 ] && envs=32 model=()
+printf '# actor hosts of this test\n%s 1 %s\n%s   # one actor, --envs environments\n' "$ns_a" "$envs" "$ns_b" > "$work/hosts"
 launcher=(ip netns exec "$ns_l" env MASA_BUILD_DIR="$build" MASA_LCM_URL="$url"
           MASA_REMOTE_SHELL="bash $PWD/tests/integration/netns_shell.sh"
-          bash deploy/train.sh a1_beam masa --hosts "$work/hosts" --envs 8
-          --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.minibatch_size=256)
+          bash deploy/train.sh a1_beam masa --hosts "$work/hosts" --envs "$envs" "${model[@]+"${model[@]}"}")
 
 no_actor_left() { [ -z "$(ip netns pids "$ns_a")$(ip netns pids "$ns_b")" ]; }
 run_dir_of() { ls -d "$1"/*/ 2>/dev/null | head -1; }
 
 if [ "$drop" -gt 0 ] || [ "$measure" -gt 0 ]; then
-  # Random loss of the rollout datagrams that reach the learner's host from the actor hosts (tc
-  # netem is not in this kernel). Only datagrams over 1000 bytes are dropped: rollout chunks are
-  # larger, heartbeats and hellos smaller. Dropping those too made the test flaky (CI: 7 datagrams
-  # dropped, all heartbeats, no chunk lost). With about 4 chunks an update, 12 updates leave a
-  # 20% loss about 0.8^48 ~ 2e-5 chance of missing every counted chunk. The learner's own
-  # multicast, looped back, is spared: LCM's start-up self test needs it.
-  ip netns exec "$ns_l" nft -f - <<EOF
+  # drop_on NS OWN_ADDRESS MATCH: nftables in NS drops $drop% of the datagrams to the run's port
+  # that come from another host and fit MATCH, and counts them.
+  drop_on() {
+    ip netns exec "$1" nft -f - <<EOF
 table inet masa_test {
   chain input {
     type filter hook input priority 0; policy accept;
-    ip saddr != 10.77.0.1 udp dport $port udp length > 1000 numgen random mod 100 < $drop counter drop
+    ip saddr != $2 udp dport $port $3 numgen random mod 100 < $drop counter drop
   }
 }
 EOF
-  log "nftables on $ns_l drops $drop% of the UDP datagrams over 1000 bytes to port $port from the actor hosts"
+  }
+  if [ "$everywhere" = 1 ]; then
+    # Every host, every datagram of the run from another host, in both directions: parameters to
+    # the actor hosts, rollouts and heartbeats to the learner's host. A host's own multicast,
+    # looped back, is spared (it never crosses the LAN, and LCM's start-up self test needs it).
+    drop_on "$ns_l" 10.77.0.1 ""
+    drop_on "$ns_a" 10.77.0.2 ""
+    drop_on "$ns_b" 10.77.0.3 ""
+    log "nftables on every host drops $drop% of the UDP datagrams to port $port from the other hosts"
+  else
+    # Random loss of the rollout datagrams that reach the learner's host from the actor hosts (tc
+    # netem is not in this kernel). Only datagrams over 1000 bytes are dropped: rollout chunks are
+    # larger, heartbeats and hellos smaller. Dropping those too made the test flaky (CI: 7 datagrams
+    # dropped, all heartbeats, no chunk lost). With about 4 chunks an update, 12 updates leave a
+    # 20% loss about 0.8^48 ~ 2e-5 chance of missing every counted chunk. The learner's own
+    # multicast, looped back, is spared: LCM's start-up self test needs it.
+    drop_on "$ns_l" 10.77.0.1 "udp length > 1000"
+    log "nftables on $ns_l drops $drop% of the UDP datagrams over 1000 bytes to port $port from the actor hosts"
+  fi
+  dropped_datagrams() {
+    local ns n total=0
+    for ns in "$ns_l" "$ns_a" "$ns_b"; do
+      n=$(ip netns exec "$ns" nft list chain inet masa_test input 2>/dev/null | sed -n 's/.*counter packets \([0-9]*\).*/\1/p')
+      total=$((total + ${n:-0}))
+    done
+    echo "$total"
+  }
   if [ "$measure" -gt 0 ]; then
     MASA_RUNS_DIR="$work/runs" timeout 600 "${launcher[@]}" --updates "$measure" > "$work/launcher.log" 2>&1 ||
       fail "the launcher did not finish $measure updates with $drop% loss (status $?)"
@@ -110,20 +141,33 @@ EOF
     drops=$(grep "^masa_learner: rollout chunks accepted" "$work/launcher.log" | tail -1 | sed 's/^masa_learner: //')
     short=$(sed -n 's/^masa_learner: updates on batches short of lost environments \([0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
     [ -n "$short" ] && drops="$drops, short batches $short"
-    dropped=$(ip netns exec "$ns_l" nft list chain inet masa_test input | sed -n 's/.*counter packets \([0-9]*\).*/\1/p')
-    echo "MEASURE: drop $drop% updates $measure datagrams_dropped ${dropped:-0} ($drops) updates_per_minute $upm"
+    repeats=$(sed -n 's/^masa_learner: parameter broadcasts repeated for actors that had not acknowledged them \([0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
+    [ -n "$repeats" ] && drops="$drops, parameters repeated $repeats"
+    dropped=$(dropped_datagrams)
+    echo "MEASURE: drop $drop% $([ "$everywhere" = 1 ] && echo "everywhere " || true)updates $measure datagrams_dropped ${dropped:-0} ($drops) updates_per_minute $upm"
     rm -rf "$work"
     exit 0
   fi
   MASA_RUNS_DIR="$work/runs" timeout 90 "${launcher[@]}" --updates 12 > "$work/launcher.log" 2>&1 ||
     fail "the launcher did not finish 12 updates with $drop% loss (status $?)"
   grep -q "stopped after 12 updates; checkpoint written" "$work/launcher.log" || fail "the learner did not finish 12 updates"
-  dropped=$(ip netns exec "$ns_l" nft list chain inet masa_test input | sed -n 's/.*counter packets \([0-9]*\).*/\1/p')
+  dropped=$(dropped_datagrams)
   [ "${dropped:-0}" -gt 0 ] || fail "nftables dropped nothing: the fault was not injected"
   lost=$(sed -n 's/^masa_learner: rollout chunks accepted.*, lost \([0-9][0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
   [ -n "$lost" ] && [ "$lost" -gt 0 ] || fail "nftables dropped $dropped datagrams but the learner counted no lost chunk"
+  repaired=""
+  if [ "$everywhere" = 1 ]; then
+    # Parameters were lost on their way to the actor hosts, and the learner repeated them for the
+    # actors that had not acknowledged them, instead of leaving them to its periodic republish.
+    to_actors=$(( $(dropped_datagrams) - $(ip netns exec "$ns_l" nft list chain inet masa_test input | sed -n 's/.*counter packets \([0-9]*\).*/\1/p') ))
+    [ "$to_actors" -gt 0 ] || fail "nftables dropped nothing on the actor hosts: the parameters' loss was not injected"
+    repeats=$(sed -n 's/^masa_learner: parameter broadcasts repeated for actors that had not acknowledged them \([0-9]*\).*/\1/p' "$work/launcher.log" | tail -1)
+    [ -n "$repeats" ] && [ "$repeats" -gt 0 ] ||
+      fail "$to_actors datagrams to the actor hosts were dropped, but the learner repeated no parameters for an actor that had not acknowledged them"
+    repaired=", $to_actors of them on the actor hosts, the learner repeated its parameters $repeats times"
+  fi
   wait_until 15 "the remote actors to stop after the run" no_actor_left
-  echo "PASS: 12 updates over the namespace LAN with $drop% random loss; nftables dropped $dropped datagrams, the learner counted $lost lost chunks"
+  echo "PASS: 12 updates over the namespace LAN with $drop% random loss$([ "$everywhere" = 1 ] && echo " on every host" || true); nftables dropped $dropped datagrams$repaired, the learner counted $lost lost chunks"
   rm -rf "$work"
   exit 0
 fi

@@ -237,6 +237,53 @@ TEST(ActorRollouts, HeartbeatNamesTheActorAndItsVersion) {
   EXPECT_GT(last.steps_per_second, 0.0f);
 }
 
+// On a lossy LAN the learner repeats its parameters until every actor acknowledges them (issue
+// #33): an actor sends a heartbeat naming the newest version it holds as soon as parameters reach
+// it, between the steps of a rollout too (it acts with them from the next rollout), and again for a
+// repeat (its acknowledgement may have been lost); a rejected message is not acknowledged.
+TEST(ActorRollouts, ParametersAreAcknowledgedAtOnceInAHeartbeatAndARejectedMessageIsNot) {
+  const auto rc = smallConfig(3, "a1_beam");
+  transport::Transport bus("memq://");
+  Capture cap(bus);
+  FakeLearner learner(rc, 5);
+  auto o = options(2, -1);
+  o.heartbeat_interval_s = 3600;  // no heartbeat but the acknowledgements
+  o.after_step = [&](int64_t rollout, int t) {
+    if (rollout == 0 && t == 1) bus.publish(transport::kPolicyChannel, learner.message(5));
+  };
+  actor::Actor actor(rc, o, &bus);
+  actor.publishHeartbeat();
+  bus.drain();
+  cap.heartbeats.clear();
+
+  bus.publish(transport::kPolicyChannel, learner.message(4));
+  ASSERT_TRUE(actor.pollParams(10));
+  bus.drain();
+  ASSERT_EQ(cap.heartbeats.size(), 1u) << "parameters came and no heartbeat said so";
+  EXPECT_EQ(cap.heartbeats[0].params_version, 4);
+  EXPECT_EQ(cap.heartbeats[0].policy_version, 4);
+
+  bus.publish(transport::kPolicyChannel, learner.message(4));  // the learner's repeat
+  actor.pollParams(0);
+  bus.drain();
+  ASSERT_EQ(cap.heartbeats.size(), 2u) << "a repeat is acknowledged again";
+  EXPECT_EQ(cap.heartbeats[1].params_version, 4);
+
+  auto hostile = learner.message(5);
+  hostile.task = "no_such_task";
+  bus.publish(transport::kPolicyChannel, hostile);
+  actor.pollParams(0);
+  bus.drain();
+  EXPECT_EQ(actor.paramsRejected(), 1);
+  EXPECT_EQ(cap.heartbeats.size(), 2u) << "a rejected message was acknowledged";
+
+  ASSERT_TRUE(actor.collectAndPublish());  // version 5 arrives at step 1
+  bus.drain();
+  ASSERT_EQ(cap.heartbeats.size(), 3u);
+  EXPECT_EQ(cap.heartbeats[2].params_version, 5) << "acknowledged mid-rollout";
+  EXPECT_EQ(cap.heartbeats[2].policy_version, 4) << "still acting with version 4 until the next rollout";
+}
+
 TEST(ActorRollouts, ParametersOfAnotherRunOrTaskAreIgnored) {
   const auto rc = smallConfig(4);
   transport::Transport bus("memq://");

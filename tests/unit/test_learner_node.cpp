@@ -21,6 +21,7 @@
 #include "common/transport/message_auth.hpp"
 #include "actors/rollout_chunker.hpp"
 #include "learner/learner.hpp"
+#include "masa/lcmt_actor_heartbeat.hpp"
 #include "masa/lcmt_learner_stats.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
@@ -370,6 +371,117 @@ TEST(LearnerNode, ABatchFormsShortOfLostChunksOnceTheirLossIsKnown) {
   EXPECT_EQ(learner.version(), 4);
   EXPECT_EQ(learner.shortBatches(), 2);
   fs::remove_all(dir);
+}
+
+// A parameter broadcast lost on its way to an actor (issue #33: on a lossy LAN a 215 KB broadcast
+// is lost whole when any of its 4 fragments is) is repeated after runner.repeat_unacknowledged_s
+// while a live actor has not acknowledged it, not only after runner.republish_every_s; the actor's
+// acknowledging heartbeat ends the repeats, and heartbeats of another run or a wild actor id move
+// nothing.
+TEST(LearnerNode, ParametersAreRepeatedUntilEveryLiveActorAcknowledgesThem) {
+  auto rc = smallConfig();
+  rc.runner.republish_every_s = 30;  // the periodic republish out of the way
+  rc.runner.repeat_unacknowledged_s = 0.05;
+  const fs::path dir = freshDir("repeat");
+  Learner learner(rc, options(dir, 23));
+  int broadcasts = 0;
+  int64_t latest = -1;
+  learner.transport().subscribe<masa::lcmt_policy_params>(transport::kPolicyChannel,
+                                                          [&](const masa::lcmt_policy_params& m) {
+                                                            ++broadcasts;
+                                                            latest = m.version;
+                                                          });
+  auto heartbeat = [&](int64_t run_id, int actor_id, int64_t holds) {
+    masa::lcmt_actor_heartbeat h{};
+    h.run_id = run_id;
+    h.actor_id = actor_id;
+    h.hostname = "test";
+    h.policy_version = holds;
+    h.params_version = holds;
+    learner.transport().publish(transport::kHeartbeatChannel, h);
+  };
+  auto stepFor = [&](double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end) learner.step(5);
+  };
+  stepFor(0.1);
+  broadcasts = 0;
+  stepFor(0.3);
+  EXPECT_EQ(broadcasts, 0) << "no actor known: only the periodic republish";
+
+  heartbeat(24, 0, -1);        // another run
+  heartbeat(23, -1, -1);       // ids the assembler would refuse
+  heartbeat(23, 1 << 20, -1);
+  heartbeat(23, 0, -7);        // no such version
+  stepFor(0.3);
+  EXPECT_EQ(broadcasts, 0) << "a heartbeat the learner does not believe moved the repeats";
+
+  heartbeat(23, 0, -1);  // actor 0 is live and holds nothing: the initial broadcast was lost
+  stepFor(0.3);          // repeats at 0, 75, 187 ms (then 356)
+  EXPECT_GE(broadcasts, 2) << "the learner waited for its periodic republish";
+  EXPECT_LE(broadcasts, 4) << "repeats come at growing intervals";
+  learner.transport().drain();  // the last repeat, published in the last step
+  EXPECT_EQ(latest, 0);
+  EXPECT_EQ(learner.unacknowledgedRepeats(), broadcasts);
+
+  heartbeat(23, 0, 0);  // acknowledged
+  stepFor(0.05);
+  broadcasts = 0;
+  stepFor(0.3);
+  EXPECT_EQ(broadcasts, 0) << "repeated after the acknowledgement";
+
+  // An update: version 1 goes out, and is repeated until actor 0 says it holds it. Its rollout of
+  // version 0 is no acknowledgement of version 1.
+  FakeActor actor(rc, 3);
+  actor.send(learner.transport(), 23, 0, 0);
+  ASSERT_TRUE(stepUntilUpdate(learner));
+  stepFor(0.2);
+  EXPECT_EQ(latest, 1);
+  EXPECT_GE(broadcasts, 2) << "the update's broadcast and at least one repeat";
+  heartbeat(23, 0, 1);
+  stepFor(0.05);
+  broadcasts = 0;
+  stepFor(0.3);
+  EXPECT_EQ(broadcasts, 0);
+  fs::remove_all(dir);
+}
+
+// The bookkeeping behind the repeats, without a clock.
+TEST(ParamsDelivery, RepeatsForALiveActorThatHasNotAcknowledgedAtGrowingIntervalsUntilItDoesOrFallsSilent) {
+  using Clock = ParamsDelivery::Clock;
+  const Clock::time_point t0{};
+  const auto ms = [](double x) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(x)); };
+  ParamsDelivery d(0.1, 1.0, 3.0);
+  d.published(5, t0);
+  EXPECT_EQ(d.nextRepeat(t0), Clock::time_point::max()) << "nobody known";
+  d.actorHolds(2, 4, t0 + ms(1));
+  EXPECT_EQ(d.nextRepeat(t0 + ms(1)), t0 + ms(100));
+  EXPECT_FALSE(d.repeatDue(t0 + ms(99)));
+  EXPECT_TRUE(d.repeatDue(t0 + ms(100)));
+  d.published(5, t0 + ms(100));
+  EXPECT_EQ(d.nextRepeat(t0 + ms(100)), t0 + ms(250)) << "1.5x the interval";
+  d.published(5, t0 + ms(250));
+  EXPECT_EQ(d.nextRepeat(t0 + ms(250)), t0 + ms(475));
+  for (int i = 0; i < 10; ++i) d.published(5, t0 + ms(500));
+  EXPECT_EQ(d.nextRepeat(t0 + ms(500)), t0 + ms(1500)) << "at most max_repeat_s";
+
+  d.actorHolds(2, 5, t0 + ms(600));  // acknowledged
+  EXPECT_EQ(d.nextRepeat(t0 + ms(600)), Clock::time_point::max());
+  d.actorHolds(2, 4, t0 + ms(610));  // a late chunk acted with the version before
+  EXPECT_EQ(d.nextRepeat(t0 + ms(610)), Clock::time_point::max()) << "the acknowledgement stands";
+
+  d.published(6, t0 + ms(700));  // a new version: the intervals start again
+  EXPECT_EQ(d.nextRepeat(t0 + ms(700)), t0 + ms(800));
+  EXPECT_EQ(d.nextRepeat(t0 + ms(610) + ms(3000)), t0 + ms(800)) << "live for 3 s after it was heard";
+  EXPECT_EQ(d.nextRepeat(t0 + ms(611) + ms(3000)), Clock::time_point::max()) << "silent: not waited for";
+
+  d.actorHolds(7, 9, t0 + ms(3700));  // holds a version the learner is not at (it resumed behind)
+  EXPECT_NE(d.nextRepeat(t0 + ms(3700)), Clock::time_point::max());
+
+  ParamsDelivery off(0.0, 1.0, 3.0);
+  off.published(1, t0);
+  off.actorHolds(0, -1, t0);
+  EXPECT_EQ(off.nextRepeat(t0), Clock::time_point::max()) << "repeat_unacknowledged_s 0: never";
 }
 
 TEST(LearnerNode, AMinibatchSizeThatDoesNotDivideTheBatchIsRefusedByName) {
