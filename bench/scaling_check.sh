@@ -53,7 +53,7 @@ point() {  # point ACTORS RANKS LAG
   line=$(bench/e2e_ranks.sh a1_beam --ranks "$l" --actors "$a" --envs "$envs" --updates "$updates" --warmup "$warmup" \
     --lag "$lag" --out "$out/e2e_a${a}_l${l}_lag${lag}") || { echo "# $line" | tee -a "$out/check.txt"; return 0; }
   echo "# $line" | tee -a "$out/check.txt"
-  fps=$(sed -n 's/.*fps median \([0-9.]*\) .*/\1/p' <<< "$line")
+  fps=$(sed -n 's/.*: fps \([0-9.]*\) (wall clock.*/\1/p' <<< "$line")
   echo "fps $fps $a $envs 24 $l 1 $cores $lag" >> "$out/points.txt"
 }
 for l in 1 2; do  # cores of their own

@@ -40,7 +40,7 @@ run_on() {  # run_on CORES ACTORS RANKS LAG NAME: e2e_ranks.sh on the first CORE
   local c=$1 a=$2 l=$3 lag=$4 line fps
   line=$(taskset -c "0-$((c - 1))" bench/e2e_ranks.sh a1_beam --ranks "$l" --actors "$a" --envs "$envs" \
     --updates 16 --warmup 5 --lag "$lag" --out "$out/$5") || true
-  fps=$(sed -n 's/.*fps median \([0-9.]*\) .*/\1/p' <<< "$line")
+  fps=$(sed -n 's/.*: fps \([0-9.]*\) (wall clock.*/\1/p' <<< "$line")
   echo "$line (on $c cores)"
   [ -n "$fps" ] && echo "fps $fps $a $envs 24 $l 1 $c $lag" >> "$out/points.txt"
   return 0
