@@ -124,6 +124,9 @@ Actor::~Actor() = default;
 void Actor::onParams(const masa::lcmt_policy_params& m) {
   if (!params_check_->ofThisRun(m)) return;  // another run on the same network
   const int64_t newest = std::max(version_, pending_version_);
+  // Checked before anything it says is believed, a repeat at our version too (docs/inputs.md gap 10:
+  // a malformed message at our version used to count as the learner being alive).
+  if (const auto why = params_check_->refusal(m, newest)) return rejectParams(m.version, *why);
   if (m.version == newest) {  // the learner's periodic repeat: it is alive, and agrees with us
     last_learner_s_ = nowSeconds();
     behind_in_a_row_ = 0;
@@ -131,7 +134,6 @@ void Actor::onParams(const masa::lcmt_policy_params& m) {
     return;
   }
   const bool behind = m.version < newest;
-  if (const auto why = params_check_->refusal(m, newest)) return rejectParams(m.version, *why);
   const int n = m.num_params;
   if (behind) {
     // Usually a late copy of older parameters: ignored. But when valid parameters below ours keep

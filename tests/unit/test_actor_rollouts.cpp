@@ -2,6 +2,8 @@
 // chunks and heartbeats out.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <thread>
 
 #include <chrono>
@@ -578,6 +580,25 @@ TEST(ActorRollouts, TheLearnersRepeatedParametersKeepTheActorGoing) {
   actor::Actor actor(rc, opt, &bus);
   bus.publish(transport::kPolicyChannel, learner.message(0));
   EXPECT_EQ(actor.run(), 6);
+}
+
+// docs/inputs.md gap 10: a message at the actor's own version was taken as the learner's repeat
+// unchecked; a malformed one (a NaN parameter) now is refused, counted, and keeps nothing going.
+TEST(ActorRollouts, AMalformedMessageAtTheActorsVersionIsRefusedAndDoesNotCountAsTheLearner) {
+  const auto rc = smallConfig(12);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  auto opt = options(2, 20);
+  opt.await_params_s = 0.05;
+  opt.learner_silence_pause_s = 0.3;
+  opt.learner_silence_exit_s = 0.6;
+  masa::lcmt_policy_params bad = learner.message(0);
+  bad.params[0] = std::numeric_limits<float>::quiet_NaN();
+  bus.subscribeRaw(transport::kRolloutChannel, [&](const void*, int) { bus.publish(transport::kPolicyChannel, bad); });
+  actor::Actor actor(rc, opt, &bus);
+  bus.publish(transport::kPolicyChannel, learner.message(0));
+  EXPECT_LT(actor.run(), 20) << "malformed repeats kept the actor going as if its learner were alive";
+  EXPECT_GT(actor.paramsRejected(), 0);
 }
 
 }  // namespace
