@@ -206,7 +206,9 @@ void Actor::publishHeartbeat() {
   hb.policy_version = version_;
   hb.rollouts_sent = rollouts_sent_;
   hb.params_version = std::max(version_, pending_version_);
-  sender().publish(transport::kHeartbeatChannel, hb);
+  // On the parameters' URL: the learner that publishes parameters (rank 0 of a data-parallel job)
+  // takes them as acknowledgements; with one URL for both, this is the rollouts' URL too.
+  transport_->publish(transport::kHeartbeatChannel, hb);
   last_heartbeat_s_ = now;
   steps_since_heartbeat_ = 0;
   acknowledge_ = false;

@@ -118,10 +118,10 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   if (isLeadRank() && intake_url != opt_.url)
     policy_transport_ = std::make_unique<transport::Transport>(opt_.url, opt_.run_key);
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
-  // Actors acknowledge parameters in their heartbeats, which come with their rollouts (rank 0
-  // hears its own actors: the others' heartbeats go to their ranks).
+  // Actors acknowledge parameters in their heartbeats, which they send on the parameters' URL:
+  // rank 0 hears every actor of a data-parallel job there, not only those that feed its own URL.
   if (isLeadRank())
-    transport_->subscribe<masa::lcmt_actor_heartbeat>(transport::kHeartbeatChannel,
+    publisher().subscribe<masa::lcmt_actor_heartbeat>(transport::kHeartbeatChannel,
                                                       [this](const masa::lcmt_actor_heartbeat& m) { onHeartbeat(m); });
 
   if (isLeadRank()) {
@@ -215,6 +215,10 @@ int Learner::waitMs(int timeout_ms) const {
 bool Learner::step(int timeout_ms) {
   transport_->handleTimeout(waiting_for_ranks_ ? std::min(timeout_ms, 1) : waitMs(timeout_ms));
   transport_->drain();
+  if (policy_transport_) {  // rank 0 of several: the actors' heartbeats (acknowledgements)
+    policy_transport_->handleTimeout(0);
+    policy_transport_->drain();
+  }
   bool updated = false;
   if (!waiting_for_ranks_) {
     bool batch = collector_ && collector_->take(*buffer_);

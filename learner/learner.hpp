@@ -110,6 +110,7 @@ class Learner {
   int silentRanksAtStop() const { return silent_ranks_at_stop_; }
   // Parameter broadcasts repeated because a live actor had not acknowledged them (params_delivery.hpp).
   int64_t unacknowledgedRepeats() const { return unacknowledged_repeats_; }
+  int acknowledgingActors() const { return delivery_.knownActors(); }
   const UpdateReport& lastReport() const { return report_; }
 
  private:

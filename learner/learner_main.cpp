@@ -173,7 +173,8 @@ int main(int argc, char** argv) {
     std::cout << who << ": updates on batches short of lost environments " << learner.shortBatches() << std::endl;
     if (lead)
       std::cout << who << ": parameter broadcasts repeated for actors that had not acknowledged them "
-                << learner.unacknowledgedRepeats() << std::endl;
+                << learner.unacknowledgedRepeats() << "; actors that acknowledged parameters "
+                << learner.acknowledgingActors() << std::endl;
     std::cout << who << ": MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
     std::cout << who << ": other messages rejected before decoding: " << learner.transport().rejectSummary()
               << std::endl;

@@ -44,4 +44,10 @@ ParamsDelivery::Clock::time_point ParamsDelivery::nextRepeat(Clock::time_point n
   return Clock::time_point::max();
 }
 
+int ParamsDelivery::knownActors() const {
+  int n = 0;
+  for (const ActorState& a : actors_) n += a.known ? 1 : 0;
+  return n;
+}
+
 }  // namespace masa::learner

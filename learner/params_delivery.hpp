@@ -41,6 +41,8 @@ class ParamsDelivery {
   bool repeatDue(Clock::time_point now) const { return now >= nextRepeat(now); }
   // When repeatDue() turns true by time alone; Clock::time_point::max() when nobody is waited for.
   Clock::time_point nextRepeat(Clock::time_point now) const;
+  // Actors that have said what they hold, ever (the learner reports it at exit).
+  int knownActors() const;
 
  private:
   struct ActorState {

@@ -5,7 +5,8 @@
 #     rank listened on its rank port: it hung before the fix).
 #  1. The job trains to --max-updates and every process exits 0: the actors stop when the learner
 #     ranks end training. metrics.csv has one row per update and counts the env steps of both
-#     ranks; the ranks checked their parameter hashes (every 2 updates) without a mismatch.
+#     ranks; the ranks checked their parameter hashes (every 2 updates) without a mismatch; rank 0
+#     heard both actors acknowledge parameters (it heard only its own before).
 #  2. Resumed as a new job from rank 0's checkpoint, it goes on to the new total.
 #  3. A learner rank killed with SIGKILL ends the whole job within seconds (no hang).
 #  4. Ctrl-C of mpirun (SIGINT) stops every process within seconds, the learners after a checkpoint.
@@ -51,6 +52,8 @@ grep -q "rank 1 of 2: run id" "$work/job1.log" || fail "no rank 1"
 [ "$(grep -c 'rollouts to learner rank' "$work/job1.log")" -eq 2 ] || fail "the actors did not report their ranks"
 grep -q "differ between learner ranks" "$work/job1.log" && fail "the ranks disagreed"
 grep -q "stopped after" "$work/job1.log" || fail "no clean stop"
+# Rank 0 broadcasts the parameters and hears every actor's acknowledgement, not only its own actor's.
+grep -q "actors that acknowledged parameters 2" "$work/job1.log" || fail "rank 0 did not hear both actors acknowledge"
 [ -f "$work/run/checkpoint.bin" ] && [ -f "$work/run/policy.bin" ] || fail "rank 0 wrote no checkpoint or policy"
 log "   6 updates, $steps env steps, every process exited 0"
 
