@@ -38,14 +38,19 @@ cp "$run/config.yaml" "$run/metrics.csv" "$out/"
 "$build/tools/masa_eval" "$out/policy.bin" --episodes "$episodes" --threads "$(nproc)" --csv "$out/eval.csv" \
   | grep -v '^wrote' > "$out/eval.txt"
 xvfb-run -a "$build/tools/masa_eval" "$out/policy.bin" --episodes 1 --video "$out/strip.png" --width 400 --height 300 > /dev/null
-updates=$(tail -n 1 "$run/metrics.csv" | cut -d, -f1) steps=$(tail -n 1 "$run/metrics.csv" | cut -d, -f2)
-wall=$(tail -n 1 "$run/metrics.csv" | cut -d, -f3)
+# By column name: a run of older binaries has `epoch,version,...` where today's has `update,...`
+# (its version is the update count).
+column() {
+  awk -F, -v want="$1" -v alt="${2:-}" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == want || $i == alt) c = i; next }
+    { v = $c } END { print v }' "$run/metrics.csv"
+}
+updates=$(column update version) steps=$(column env_steps) wall=$(column wall_time_s)
 # policy/README.md: what was shipped, how it was made, and how it does.
 {
   echo "# $task: shipped policy"
   echo
   echo "Trained $(date -r "$run/metrics.csv" +%Y-%m-%d) by commit ${commit:0:7} on $(nproc --all) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')):"
-  echo "$((updates + 1)) updates, $steps env steps, $(printf %.0f "$wall") s of training wall time. Run configuration: \`config.yaml\`."
+  echo "$updates updates, $steps env steps, $(printf %.0f "$wall") s of training wall time. Run configuration: \`config.yaml\`."
   if [ -f "$run.log" ]; then
     echo "The command (from the run's log): \`$(grep -m1 -o 'masa_train .*' "$run.log" | sed 's/ --run-dir [^ ]*//; s/ *$//')\`."
   fi

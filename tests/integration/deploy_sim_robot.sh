@@ -10,7 +10,7 @@
 #   second_runner a second runner is refused by the start guard; the first goes on
 #   faults        commands delayed 4-8 ms and 5% of states and commands lost: the A1 still walks at
 #                 least 0.8 of masa_eval's distance in the same number of policy steps, without falling
-#   humanoid      the shipped Humanoid Tightrope policy (torque commands) lunges along the simulated
+#   humanoid      the shipped Humanoid Tightrope policy (torque commands) walks along the simulated
 #                 rope at least 0.8 of masa_eval's distance over as many control periods, no fall
 #   crouch        the A1 reports a 1 rad roll (a fall, to its IMU): the emergency stop folds it
 #                 into configs/deploy/a1_beam_sim.yaml's crouch pose, targets no faster than its rate
@@ -173,11 +173,11 @@ second_runner)
 humanoid)
   policy="$src/tasks/humanoid_tightrope/policy/policy.bin"
   config="$src/configs/deploy/humanoid_tightrope_sim.yaml"
-  steps=60  # 0.9 s of the 1.8 s lunge: the policy falls after it, in evaluation too
+  steps=60  # 0.9 s of its walk (the shipped policy walks the 1000 steps, 26 m, in evaluation)
   drive humanoid $steps 2
-  # A lunge is a fall held off by the policy: a few ms of timing shift the chaos, not the distance.
-  le "$(awk -v e="$evaluated" 'BEGIN { print 0.8 * e }')" "$walked" || fail "lunged $walked m < 0.8 x $evaluated m"
-  echo "PASS: the humanoid lunged $walked m along the rope over LCM (masa_eval: $evaluated m)"
+  # Over LCM a few ms of timing shift the gait, not the distance.
+  le "$(awk -v e="$evaluated" 'BEGIN { print 0.8 * e }')" "$walked" || fail "walked $walked m < 0.8 x $evaluated m"
+  echo "PASS: the humanoid walked $walked m along the rope over LCM (masa_eval: $evaluated m)"
   ;;
 crouch)
   # The roll must be what stops the runner: a watchdog trip for stale state before it (a runner not
