@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
   CLI::App app{"masa sac: soft actor-critic with automatic temperature, single process"};
   app.set_version_flag("--version", masa::buildCommit());
   std::vector<std::string> overrides;
-  std::string task = "a1_beam", method = "masa", run_dir, configs = config::defaultConfigsDir(), recipe;
+  std::string task = "a1_beam", method = "masa", run_dir, configs = config::defaultConfigsDir(), recipe, resume;
   long long steps = 0, seed = -1;
   int threads = 1;
   bool quiet = false;
@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   app.add_option("--method", method, "masa | sa | sasa | ma")->capture_default_str();
   app.add_option("--steps", steps, "environment steps (default: sac.env_steps)")->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "seed of everything random in the run (default: the config's)")->check(CLI::NonNegativeNumber);
+  app.add_option("--resume", resume, "run directory to go on from (its config.yaml and sac_state.bin; --steps may raise the total)");
   app.add_option("--out", run_dir, "run directory (default runs/<task>_sac_<method>_<seed>)");
   app.add_option("--recipe", recipe, "a recipe of configs/recipes/ (or a YAML file) for the env section, before --set");
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set sac.n_step=3");
@@ -34,6 +35,17 @@ int main(int argc, char** argv) {
 
   omp_set_num_threads(threads);
   try {
+    if (!resume.empty()) {
+      std::vector<std::string> all = overrides;
+      if (steps > 0) all.push_back("sac.env_steps=" + std::to_string(steps));
+      const config::RunConfig rc = config::loadRunConfig(configs, all, resume + "/config.yaml");
+      sac::SacRunOptions o;
+      o.run_dir = resume;
+      o.verbose = !quiet;
+      o.resume = true;
+      sac::SacRun(rc, o).run();
+      return 0;
+    }
     std::vector<std::string> all = {"task=" + task};
     if (!recipe.empty()) all.push_back("@" + recipe);
     all.insert(all.end(), overrides.begin(), overrides.end());

@@ -29,17 +29,25 @@ ReplayBuffer::ReplayBuffer(int obs_dim, int act_dim, long long capacity)
     : obs_dim_(obs_dim), act_dim_(act_dim), capacity_(capacity) {
   MASA_CHECK(obs_dim > 0 && act_dim > 0, "a replay buffer needs observations and actions");
   MASA_CHECK(capacity > 0, "replay capacity must be positive, got " << capacity);
-  obs_.resize(static_cast<size_t>(capacity * obs_dim));
-  next_obs_.resize(static_cast<size_t>(capacity * obs_dim));
-  actions_.resize(static_cast<size_t>(capacity * act_dim));
-  rewards_.resize(static_cast<size_t>(capacity));
-  terminated_.resize(static_cast<size_t>(capacity));
-  truncated_.resize(static_cast<size_t>(capacity));
+}
+
+void ReplayBuffer::reserveSlots(long long slots) {
+  // Storage grows with use (doubling), so a large capacity costs memory only once it is filled.
+  if (slots <= allocated_) return;
+  const long long n = std::min(capacity_, std::max({slots, 2 * allocated_, 1024LL}));
+  obs_.resize(static_cast<size_t>(n * obs_dim_));
+  next_obs_.resize(static_cast<size_t>(n * obs_dim_));
+  actions_.resize(static_cast<size_t>(n * act_dim_));
+  rewards_.resize(static_cast<size_t>(n));
+  terminated_.resize(static_cast<size_t>(n));
+  truncated_.resize(static_cast<size_t>(n));
+  allocated_ = n;
 }
 
 void ReplayBuffer::add(const float* obs, const float* action, double reward, const float* next_obs, bool terminated,
                        bool truncated) {
   const long long k = next_;
+  reserveSlots(k + 1);
   std::memcpy(obs_.data() + k * obs_dim_, obs, sizeof(float) * obs_dim_);
   std::memcpy(next_obs_.data() + k * obs_dim_, next_obs, sizeof(float) * obs_dim_);
   std::memcpy(actions_.data() + k * act_dim_, action, sizeof(float) * act_dim_);
@@ -125,6 +133,7 @@ void ReplayBuffer::load(std::istream& is) {
                              std::to_string(h[2]) + " (obs/act/capacity), this one " + std::to_string(obs_dim_) + "/" +
                              std::to_string(act_dim_) + "/" + std::to_string(capacity_));
   if (h[3] < 0 || h[3] > capacity_ || h[4] < 0 || h[4] >= capacity_) throw std::runtime_error("replay buffer: corrupt position");
+  reserveSlots(h[3]);
   size_ = h[3];
   next_ = h[4];
   added_ = h[5];

@@ -59,8 +59,10 @@ class ReplayBuffer {
   void load(std::istream& is);  // throws std::runtime_error on a shape mismatch or truncation
 
  private:
+  void reserveSlots(long long slots);
+
   int obs_dim_, act_dim_;
-  long long capacity_;
+  long long capacity_, allocated_ = 0;
   long long size_ = 0, next_ = 0, added_ = 0;  // next_: the slot the next add() writes
   std::vector<float> obs_, next_obs_, actions_, rewards_;
   std::vector<uint8_t> terminated_, truncated_;

@@ -75,6 +75,10 @@ SacConfig readSacConfig(const config::RunConfig& rc) {
   c.log_every = r.atLeast("log_every", 1);
   c.eval_every = r.atLeast("eval_every", 0);
   c.eval_episodes = static_cast<int>(r.atLeast("eval_episodes", 1));
+  c.checkpoint_every = r.atLeast("checkpoint_every", 0);
+  // A checkpoint is taken at a metrics row, where the row's sums are empty: nothing else to save.
+  if (c.checkpoint_every % c.log_every != 0)
+    r.fail("checkpoint_every", "must be a multiple of sac.log_every (" + std::to_string(c.log_every) + ")");
   return c;
 }
 

@@ -26,6 +26,7 @@ struct SacConfig {
   long long log_every = 1000;
   long long eval_every = 10000;
   int eval_episodes = 5;
+  long long checkpoint_every = 10000;  // env steps; a multiple of log_every (0: only at the end)
 };
 
 // Reads rc.resolved["sac"]; throws masa::ConfigError naming the key and the file that set it.

@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "common/core/binary_io.hpp"
 #include "common/model/method.hpp"
 #include "common/sim/registry.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
@@ -55,6 +56,8 @@ struct SacRun::Impl {
   std::unique_ptr<task::Task> env;
   std::vector<std::string> progress_names;
   std::ofstream csv;
+  long long t_done = 0;    // environment steps taken
+  std::vector<float> obs;  // the observation the next action is chosen from
 
   Impl(const config::RunConfig& config, SacRunOptions o)
       : rc(config),
@@ -66,15 +69,25 @@ struct SacRun::Impl {
         q(spec, twinQMaps(config.method, spec), sc.q_hidden, config.model.activation),
         q_target(spec, twinQMaps(config.method, spec), sc.q_hidden, config.model.activation),
         trainer(policy, q, q_target, sc),
-        replay(spec.obsDim(), spec.actDim(), std::min(sc.buffer_size, sc.env_steps)) {
+        replay(spec.obsDim(), spec.actDim(), sc.buffer_size) {
     policy.initialize(rng);
     q.initialize(rng);
     q_target.moveTowards(q, 1.0f);
     factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, spec, rc.env, rc.origin);
     env = factory->create();
     progress_names = env->progressNames();
+    obs.resize(spec.obsDim());
     fs::create_directories(opt.run_dir);
     std::ofstream(fs::path(opt.run_dir) / "config.yaml") << config::dumpResolved(rc);
+    if (opt.resume) {
+      loadState();
+      csv.open(fs::path(opt.run_dir) / "metrics.csv", std::ios::app);
+      if (!csv) throw std::runtime_error(opt.run_dir + "/metrics.csv: cannot append");
+      csv.precision(7);
+      return;
+    }
+    env->reset(rng);
+    env->observe(obs.data());
     csv.open(fs::path(opt.run_dir) / "metrics.csv");
     if (!csv) throw std::runtime_error(opt.run_dir + "/metrics.csv: cannot write");
     csv << "env_step,updates,wall_s,env_steps_per_s,train_return,train_length,episodes,q_loss,actor_loss,alpha_loss,"
@@ -82,6 +95,51 @@ struct SacRun::Impl {
     for (const auto& n : progress_names) csv << ",eval_" << n;
     csv << '\n';
     csv.precision(7);
+  }
+
+  static constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'S', 'R', 'U', 'N'};
+
+  // Written to a temporary file and renamed: a run stopped while saving keeps its last state.
+  void saveState() {
+    const fs::path path = fs::path(opt.run_dir) / "sac_state.bin", tmp = path.string() + ".tmp";
+    {
+      std::ofstream f(tmp, std::ios::binary);
+      f.write(kMagic, sizeof kMagic);
+      io::writePod(f, t_done);
+      trainer.save(f);
+      replay.save(f);
+      std::vector<double> task_state;
+      env->saveState(task_state);
+      const long long n = static_cast<long long>(task_state.size());
+      io::writePod(f, n);
+      f.write(reinterpret_cast<const char*>(task_state.data()), static_cast<std::streamsize>(sizeof(double) * n));
+      f.write(reinterpret_cast<const char*>(obs.data()), static_cast<std::streamsize>(sizeof(float) * obs.size()));
+      f << rng << '\n';
+      if (!f) throw std::runtime_error(tmp.string() + ": cannot write");
+    }
+    fs::rename(tmp, path);
+  }
+
+  void loadState() {
+    const fs::path path = fs::path(opt.run_dir) / "sac_state.bin";
+    std::ifstream f(path, std::ios::binary);
+    char magic[8] = {};
+    f.read(magic, sizeof magic);
+    if (!f || std::string(magic, 8) != std::string(kMagic, 8)) throw std::runtime_error(path.string() + ": not a SAC run state");
+    long long n = 0;
+    if (!io::readPod(f, t_done)) throw std::runtime_error(path.string() + ": truncated");
+    trainer.load(f);
+    replay.load(f);
+    if (!io::readPod(f, n) || n < 0 || n > (1 << 24)) throw std::runtime_error(path.string() + ": corrupt task state");
+    std::vector<double> task_state(static_cast<size_t>(n));
+    f.read(reinterpret_cast<char*>(task_state.data()), static_cast<std::streamsize>(sizeof(double) * n));
+    f.read(reinterpret_cast<char*>(obs.data()), static_cast<std::streamsize>(sizeof(float) * obs.size()));
+    f >> rng;
+    if (!f) throw std::runtime_error(path.string() + ": truncated");
+    env->loadState(task_state);
+    if (t_done > sc.env_steps)
+      throw std::runtime_error(path.string() + ": the run has taken " + std::to_string(t_done) +
+                               " steps already, more than sac.env_steps (" + std::to_string(sc.env_steps) + ")");
   }
 
   // The normalizer from the stored (random-action) observations, then fixed.
@@ -148,16 +206,16 @@ SacRunResult SacRun::run() {
                 sc.env_steps, sc.learning_starts, sc.updates_per_step, sc.batch_size, sc.n_step, m.opt.run_dir.c_str());
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  std::vector<float> obs(od), next(od), act(ad);
+  std::vector<float>& obs = m.obs;
+  std::vector<float> next(od), act(ad);
   std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
   ReplayBatch<float> batch;
   SacStats sums;
   long long updates_in_row = 0, episodes_in_row = 0;
   double ret_sum = 0, len_sum = 0;
   SacRunResult result;
-  m.env->reset(m.rng);
-  m.env->observe(obs.data());
-  for (long long t = 1; t <= sc.env_steps; ++t) {
+  if (m.opt.resume && m.opt.verbose) std::printf("resumed at env step %lld, update %lld\n", m.t_done, m.trainer.steps());
+  for (long long t = m.t_done + 1; t <= sc.env_steps; ++t) {
     if (t <= sc.learning_starts) {
       for (float& a : act) a = uniform(m.rng);
     } else {
@@ -173,8 +231,9 @@ SacRunResult SacRun::run() {
       m.env->reset(m.rng);
       m.env->observe(obs.data());
     } else {
-      obs.swap(next);
+      obs = next;
     }
+    m.t_done = t;
     if (t == sc.learning_starts) m.fitNormalizer();
     if (t >= sc.learning_starts) {
       for (int u = 0; u < sc.updates_per_step; ++u) {
@@ -227,10 +286,11 @@ SacRunResult SacRun::run() {
     sums = SacStats{};
     updates_in_row = episodes_in_row = 0;
     ret_sum = len_sum = 0;
+    if ((sc.checkpoint_every > 0 && t % sc.checkpoint_every == 0) || t == sc.env_steps) m.saveState();
   }
   result.env_steps = sc.env_steps;
   result.updates = m.trainer.steps();
-  if (m.opt.verbose) std::printf("wrote %s/{config.yaml,metrics.csv,sac_policy.bin}\n", m.opt.run_dir.c_str());
+  if (m.opt.verbose) std::printf("wrote %s/{config.yaml,metrics.csv,sac_policy.bin,sac_state.bin}\n", m.opt.run_dir.c_str());
   return result;
 }
 

@@ -532,6 +532,8 @@ TEST(SacConfigTest, DefaultsReadAndUnknownOrBadKeysAreErrorsNamingTheKey) {
   EXPECT_EQ(c.batch_size, 256);
   EXPECT_DOUBLE_EQ(c.target_entropy_per_dim, -1.0);
   EXPECT_THROW(config::loadRunConfig(configs, {"task=a1_beam", "sac.nstep=3"}), ConfigError);
+  // Checkpoints are taken at metrics rows only.
+  EXPECT_THROW(readSacConfig(config::loadRunConfig(configs, {"task=a1_beam", "sac.checkpoint_every=1500"})), ConfigError);
   try {
     readSacConfig(config::loadRunConfig(configs, {"task=a1_beam", "sac.polyak=0"}));
     FAIL() << "polyak 0 accepted";
