@@ -215,6 +215,7 @@ SacRunResult SacRun::run() {
   double ret_sum = 0, len_sum = 0;
   SacRunResult result;
   if (m.opt.resume && m.opt.verbose) std::printf("resumed at env step %lld, update %lld\n", m.t_done, m.trainer.steps());
+  const long long t_start = m.t_done;  // a resumed run's rate counts the steps of this process only
   for (long long t = m.t_done + 1; t <= sc.env_steps; ++t) {
     if (t <= sc.learning_starts) {
       for (float& a : act) a = uniform(m.rng);
@@ -252,7 +253,7 @@ SacRunResult SacRun::run() {
     const bool eval_now = (sc.eval_every > 0 && t % sc.eval_every == 0) || t == sc.env_steps;
     if (t % sc.log_every != 0 && !eval_now) continue;
     const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-    const double sps = t / std::max(wall, 1e-9);
+    const double sps = (t - t_start) / std::max(wall, 1e-9);
     Impl::Eval e;
     if (eval_now) e = m.evaluate();
     const double nu = static_cast<double>(std::max<long long>(updates_in_row, 1));
