@@ -7,11 +7,18 @@ namespace masa::offline {
 template <typename S>
 TwinQ<S>::TwinQ(const sym::SymmetrySpec& spec, model::Method method, const std::vector<int>& hidden,
                 nn::Activation activation)
-    : maps_(buildStateActionMaps(method, spec)),
+    : TwinQ(spec, buildStateActionMaps(method, spec), hidden, activation) {}
+
+template <typename S>
+TwinQ<S>::TwinQ(const sym::SymmetrySpec& spec, model::AgentMaps pair_maps, const std::vector<int>& hidden,
+                nn::Activation activation)
+    : maps_(std::move(pair_maps)),
       obs_dim_(spec.obsDim()),
       act_dim_(spec.actDim()),
       q1_(params_, "q1", &maps_, hidden, {}, activation),
       q2_(params_, "q2", &maps_, hidden, {}, activation) {
+  MASA_CHECK(maps_.obs_dim == obs_dim_ + act_dim_, "pair maps read " << maps_.obs_dim << " entries, the spec's pairs have "
+                                                                     << obs_dim_ + act_dim_);
   params_.finalize();
 }
 
@@ -41,9 +48,20 @@ Eigen::Block<Mat<S>> TwinQ<S>::forward(const ConstMatRef<S>& obs, const ConstMat
 }
 
 template <typename S>
-void TwinQ<S>::backward(const ConstMatRef<S>& dq) {
-  q1_.backward(dq.row(0));
-  q2_.backward(dq.row(1));
+void TwinQ<S>::backward(const ConstMatRef<S>& dq, MatRef<S>* dactions) {
+  if (!dactions) {
+    q1_.backward(dq.row(0));
+    q2_.backward(dq.row(1));
+    return;
+  }
+  const Eigen::Index b = dq.cols();
+  MASA_CHECK(dactions->rows() == act_dim_ && dactions->cols() == b, "dactions must be " << act_dim_ << " x " << b);
+  dpair1_.resize(obs_dim_ + act_dim_, b);
+  dpair2_.resize(obs_dim_ + act_dim_, b);
+  MatRef<S> d1 = dpair1_, d2 = dpair2_;
+  q1_.backward(dq.row(0), &d1);
+  q2_.backward(dq.row(1), &d2);
+  *dactions = d1.bottomRows(act_dim_) + d2.bottomRows(act_dim_);
 }
 
 template <typename S>

@@ -14,6 +14,10 @@ class TwinQ {
   // hidden: each Q's widths (the last one is the feature width pooled over agents).
   TwinQ(const sym::SymmetrySpec& spec, model::Method method, const std::vector<int>& hidden,
         nn::Activation activation);
+  // The same on maps of state-action pairs given by the caller (pair_maps.obs_dim = obs + act):
+  // how the off-policy learner (learner/sac) serves the methods this library does not (SASA, MA).
+  TwinQ(const sym::SymmetrySpec& spec, model::AgentMaps pair_maps, const std::vector<int>& hidden,
+        nn::Activation activation);
   TwinQ(const TwinQ&) = delete;
   TwinQ& operator=(const TwinQ&) = delete;
 
@@ -24,8 +28,9 @@ class TwinQ {
   // Q1 and Q2 (2 x B, row k = Q_(k+1)) of normalized observations (obs_dim x B) and actions
   // (act_dim x B); caches for backward. The view is valid until the next forward.
   Eigen::Block<Mat<S>> forward(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions);
-  // Accumulates parameter gradients of dL/dQ (2 x B) of the last forward.
-  void backward(const ConstMatRef<S>& dq);
+  // Accumulates parameter gradients of dL/dQ (2 x B) of the last forward. If dactions is given it
+  // receives dL/da (act_dim x B), what an actor trained through Q (SAC) needs.
+  void backward(const ConstMatRef<S>& dq, MatRef<S>* dactions = nullptr);
   // min(Q1, Q2) into out (1 x B): IQL's pessimistic target.
   void minQ(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions, MatRef<S> out);
 
@@ -37,7 +42,7 @@ class TwinQ {
   int obs_dim_, act_dim_;
   nn::ParameterSet<S> params_;
   model::SharedAgentCritic<S> q1_, q2_;
-  Mat<S> pair_, q_;
+  Mat<S> pair_, q_, dpair1_, dpair2_;
 };
 
 }  // namespace masa::offline

@@ -1,0 +1,71 @@
+// The replay buffer of the off-policy learner: the last `capacity` transitions of ONE stream of
+// environment steps in time order (an episode's steps consecutive, then the next episode's), kept
+// in a ring that overwrites the oldest. Sampling draws indices uniformly from a passed-in generator
+// and turns each into an n-step transition:
+//   R = r_k + g r_(k+1) + ... + g^(m-1) r_(k+m-1),  bootstrap from o'_(k+m-1) with discount g^m,
+// where m <= n stops early at the end of an episode: at a termination the discount is 0 (nothing
+// follows a fall), at a time-out it is g^m from the truncated step's own next observation (the
+// episode was cut, not ended), and at the newest stored step (what follows is not known yet).
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <vector>
+
+#include "common/core/types.hpp"
+
+namespace masa::sac {
+
+// A sampled minibatch; the learner's TD target is reward + discount * V(next_obs).
+template <typename S>
+struct ReplayBatch {
+  Mat<S> obs, next_obs;  // obs_dim x B, raw (the learner normalizes)
+  Mat<S> actions;        // act_dim x B, in [-1, 1]
+  Mat<S> rewards;        // 1 x B: the n-step discounted sum
+  Mat<S> discount;       // 1 x B: g^m, or 0 where the episode terminated within the m steps
+
+  int size() const { return static_cast<int>(rewards.cols()); }
+  void resize(int obs_dim, int act_dim, int batch);
+};
+
+class ReplayBuffer {
+ public:
+  ReplayBuffer(int obs_dim, int act_dim, long long capacity);
+
+  // One environment step: the observation the action was chosen from, the action, the reward, the
+  // observation after the step (before any reset), and how the episode ended if it did.
+  void add(const float* obs, const float* action, double reward, const float* next_obs, bool terminated,
+           bool truncated);
+
+  long long size() const { return size_; }
+  long long capacity() const { return capacity_; }
+  long long added() const { return added_; }  // every add() since construction, overwritten ones too
+  int obsDim() const { return obs_dim_; }
+  int actDim() const { return act_dim_; }
+
+  // Stored step `age` steps before the newest (0: the newest); for tests and the normalizer fit.
+  long long slotOfAge(long long age) const;
+  const float* obsAt(long long slot) const { return obs_.data() + slot * obs_dim_; }
+
+  // batch_size n-step transitions at indices drawn from rng (one draw per sample, in order).
+  template <typename S>
+  void sample(int batch_size, int n_step, double discount, Rng& rng, ReplayBatch<S>& batch) const;
+  // The n-step transition starting at a stored slot (what sample() does for each draw).
+  template <typename S>
+  void nStep(long long slot, int n_step, double discount, ReplayBatch<S>& batch, int column) const;
+
+  // Contents and position, binary with size checks (resume continues with the same samples).
+  void save(std::ostream& os) const;
+  void load(std::istream& is);  // throws std::runtime_error on a shape mismatch or truncation
+
+ private:
+  void reserveSlots(long long slots);
+
+  int obs_dim_, act_dim_;
+  long long capacity_, allocated_ = 0;
+  long long size_ = 0, next_ = 0, added_ = 0;  // next_: the slot the next add() writes
+  std::vector<float> obs_, next_obs_, actions_, rewards_;
+  std::vector<uint8_t> terminated_, truncated_;
+};
+
+}  // namespace masa::sac
