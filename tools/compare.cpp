@@ -23,6 +23,7 @@
 #include <sstream>
 
 #include "common/core/build_info.hpp"
+#include "common/core/shell_quoted.hpp"
 #include "common/core/summary_stats.hpp"
 
 using namespace masa;
@@ -201,10 +202,14 @@ std::string color(const std::string& method, size_t index) {
   return it != fixed.end() ? it->second : others[index % 4];
 }
 
-std::string shellQuote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
+// Task and method names are written into gnuplot scripts inside quotes, where a quote, a backquote
+// or an @ would let a directory's name run commands: only names that cannot do that are read.
+constexpr const char* kPlotSafeRule =
+    "task and method names are letters, digits and _ . + - only (they are written into gnuplot scripts)";
+bool plotSafeName(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '+' || c == '-';
+  });
 }
 
 // gnuplot lines for one panel: each method's band and median from curves/<metric>_<method>.dat.
@@ -434,6 +439,10 @@ std::optional<TaskResult> compareTask(const fs::path& dir, const std::string& ta
     std::smatch m;
     const std::string name = e.path().filename().string();
     if (!e.is_directory() || !std::regex_match(name, m, run_name)) continue;
+    if (!plotSafeName(m[1])) {
+      std::cerr << "masa_compare: skipped " << (dir / task / name).string() << ": " << kPlotSafeRule << "\n";
+      continue;
+    }
     if (!fs::exists(e.path() / "metrics.csv")) continue;
     Run run = readRun(e.path() / "metrics.csv");
     if (run.rows() < 2) continue;
@@ -570,8 +579,14 @@ int main(int argc, char** argv) {
     if (!fs::is_directory(dir)) throw std::runtime_error(dir_arg + ": no such directory");
     std::vector<Milestone> milestones = readMilestones(dir, milestone_texts);
     std::vector<std::string> task_names;
-    for (const auto& e : fs::directory_iterator(dir))
-      if (e.is_directory()) task_names.push_back(e.path().filename().string());
+    for (const auto& e : fs::directory_iterator(dir)) {
+      if (!e.is_directory()) continue;
+      const std::string name = e.path().filename().string();
+      if (plotSafeName(name))
+        task_names.push_back(name);
+      else
+        std::cerr << "masa_compare: skipped " << e.path().string() << ": " << kPlotSafeRule << "\n";
+    }
     std::sort(task_names.begin(), task_names.end());
 
     std::ostringstream verdict;
@@ -631,8 +646,8 @@ int main(int argc, char** argv) {
     if (!no_plot) {
       bool ok = true;
       for (const auto& t : drawn)
-        ok = std::system(("cd " + shellQuote((dir / t.task).string()) + " && gnuplot compare.gp").c_str()) == 0 && ok;
-      ok = std::system(("cd " + shellQuote(dir.string()) + " && gnuplot compare_all.gp").c_str()) == 0 && ok;
+        ok = std::system(("cd " + shellQuoted((dir / t.task).string()) + " && gnuplot compare.gp").c_str()) == 0 && ok;
+      ok = std::system(("cd " + shellQuoted(dir.string()) + " && gnuplot compare_all.gp").c_str()) == 0 && ok;
       if (!ok) throw std::runtime_error("gnuplot failed (is it installed? scripts/install_deps.sh installs gnuplot-nox)");
       std::printf("masa_compare: figures %s and %s/<task>/compare.png; verdict %s\n",
                   (dir / "compare_all.png").c_str(), dir.c_str(), (dir / "verdict.md").c_str());

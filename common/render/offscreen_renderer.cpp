@@ -7,6 +7,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "common/core/shell_quoted.hpp"
+
 namespace masa::render {
 
 OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height) : model_(model) {
@@ -108,7 +110,7 @@ FrameWriter::FrameWriter(const std::string& path, int width, int height, double 
                               : (path.size() > 4 && path.substr(path.size() - 4) == ".gif" ? "" : "-pix_fmt yuv420p");
   const std::string cmd = "ffmpeg -y -loglevel error -f rawvideo -pixel_format rgb24 -video_size " +
                           std::to_string(width) + "x" + std::to_string(height) + " -framerate " + std::to_string(fps) +
-                          " -i - " + filter + " '" + path + "'";
+                          " -i - " + filter + " " + shellQuoted(path);
   pipe_ = popen(cmd.c_str(), "w");
   if (!pipe_) throw std::runtime_error("cannot start ffmpeg (is the ffmpeg package installed?)");
 }
