@@ -115,6 +115,7 @@ hosts=() host_actors=() host_envs=()
 if [ -n "$hosts_file" ]; then
   [ "$actors_given" = 0 ] || { echo "train.sh: --actors and --hosts exclude each other (the hosts file gives the actors)" >&2; exit 2; }
   [ -r "$hosts_file" ] || { echo "train.sh: cannot read hosts file '$hosts_file'" >&2; exit 2; }
+  host_name_pattern='^[][A-Za-z0-9_.@:%][][A-Za-z0-9_.@:%-]*$'
   line_no=0
   while IFS= read -r line || [ -n "$line" ]; do
     line_no=$((line_no + 1))
@@ -124,6 +125,12 @@ if [ -n "$hosts_file" ]; then
     n=${n:-1} e=${e:-$envs}
     if [ -n "${extra:-}" ] || ! [[ "$n" =~ ^[1-9][0-9]*$ && "$e" =~ ^[1-9][0-9]*$ ]]; then
       echo "train.sh: $hosts_file:$line_no: expected 'host [actors] [envs]' with positive counts, got '$line'" >&2
+      exit 2
+    fi
+    # The name goes to ssh and rsync as an argument: one starting with "-" would be an option
+    # (-oProxyCommand=... runs a command), and quotes or shell syntax have no place in a host name.
+    if ! [[ "$h" =~ $host_name_pattern ]]; then
+      echo "train.sh: $hosts_file:$line_no: '$h' is not a host name ([user@]host of letters, digits and _ . : % [ ] -, not starting with -)" >&2
       exit 2
     fi
     hosts+=("$h") host_actors+=("$n") host_envs+=("$e")

@@ -37,5 +37,19 @@ for bad in "--actors 0" "--envs -1" "--updates x" "--ranks 0"; do
   # shellcheck disable=SC2086
   MASA_BUILD_DIR=$build refuse "${bad%% *}" bash "$masa_repo/deploy/train.sh" a1_beam masa $bad --run-dir "$work/sh"
 done
+# A hosts file's host names reach ssh (docs/inputs.md gap 7): one that would be read as an ssh option
+# or carries shell syntax is refused by its line before anything starts; so are bad counts.
+hosts_case() {  # hosts_case WHAT LINE: train.sh --hosts with a file of LINE must exit 2 naming the line
+  printf 'localhost 1 8\n%s\n' "$2" > "$work/hosts"
+  MASA_BUILD_DIR=$build refuse "hosts:2" bash "$masa_repo/deploy/train.sh" a1_beam masa --hosts "$work/hosts" \
+    --run-dir "$work/hosts_run"
+  [ ! -e "$work/hosts_run" ] || { echo "STARTED: $1 made the run dir"; failures=$((failures + 1)); rm -rf "$work/hosts_run"; }
+}
+hosts_case "an ssh option" "-oProxyCommand=touch\$IFS$work/pwned 1 8"
+hosts_case "shell syntax" 'host$(touch) 1 8'
+hosts_case "a quote" "it's 1 8"
+hosts_case "zero actors" "node1 0 8"
+hosts_case "an extra field" "node1 1 8 9"
+[ ! -e "$work/pwned" ] || { echo "a host name ran a command"; failures=$((failures + 1)); }
 [ "$failures" -eq 0 ] || { echo "FAIL: $failures value(s) not refused"; exit 1; }
 echo "PASS"
