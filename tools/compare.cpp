@@ -80,9 +80,21 @@ Run readRun(const fs::path& csv) {
     std::string cell;
     size_t i = 0;
     std::vector<double> values;
-    while (std::getline(ss, cell, ',')) values.push_back(std::strtod(cell.c_str(), nullptr));
-    // A row cut short by a crash is the end of the run's record.
-    if (values.size() != names.size()) break;
+    size_t bad = std::string::npos;  // the first cell that is not a number ("nan" and "inf" are)
+    std::string bad_cell;
+    while (std::getline(ss, cell, ',')) {
+      char* end = nullptr;
+      values.push_back(std::strtod(cell.c_str(), &end));
+      if (bad == std::string::npos && (cell.empty() || end != cell.c_str() + cell.size()))
+        bad = values.size() - 1, bad_cell = cell;
+    }
+    // A row cut short by a crash is the end of the run's record; a damaged cell anywhere else would
+    // read as 0 and move medians and verdicts without a word.
+    const bool last_row = in.peek() == std::char_traits<char>::eof();
+    if (values.size() != names.size() || (bad != std::string::npos && last_row)) break;
+    if (bad != std::string::npos)
+      throw std::runtime_error(csv.string() + ":" + std::to_string(line_no) + ": column '" + names[bad] + "' holds '" +
+                               bad_cell + "', not a number");
     for (i = 0; i < names.size(); ++i) run.columns[names[i]].push_back(values[i]);
   }
   return run;
