@@ -64,8 +64,9 @@ else
   [ -n "$run_dir" ] && learner_args+=(--run-dir "$run_dir")
   actor_config=("${config[@]}")
 fi
-# Open MPI refuses root unless told; a 2-core workstation runs more processes than cores.
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+# Open MPI refuses root unless told (containers and CI run as root); nobody else needs the override.
+# A 2-core workstation runs more processes than cores (--oversubscribe).
+[ "$(id -u)" -ne 0 ] || export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 set -x
 exec "${MASA_MPIRUN:-mpirun}" --oversubscribe --bind-to none -x OMP_NUM_THREADS="$threads" "${mpi_extra[@]}" \
   -np "$ranks" "$build/learner/masa_learner" "${config[@]}" "${learner_args[@]}" \
