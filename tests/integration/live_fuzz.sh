@@ -8,6 +8,7 @@
 #     an episode with it is finite), and the copies are counted (malformed chunks at the learner,
 #     rejected parameter messages at the actors; the learner reads heartbeats as acknowledgements of
 #     its parameters, through the same guard; stats have no subscriber here).
+#     masa_lcm_probe watches all four channels meanwhile and exits cleanly.
 #  2. With the run key, every copy fails its tag: the learner accepts no chunk the actors did not
 #     send, and counts the fuzzed chunks as unauthenticated.
 #   MASA_BUILD_DIR=build bash tests/integration/live_fuzz.sh [PORT]
@@ -19,7 +20,8 @@ source tests/integration/lib.sh
 port=${1:-7697}
 fuzz_bin="$build/tools/masa_lcm_fuzz"
 eval_bin="$build/tools/masa_eval"
-for b in "$fuzz_bin" "$eval_bin"; do [ -x "$b" ] || { echo "FAIL: $b is missing: build first"; exit 1; }; done
+probe_bin="$build/tools/masa_lcm_probe"
+for b in "$fuzz_bin" "$eval_bin" "$probe_bin"; do [ -x "$b" ] || { echo "FAIL: $b is missing: build first"; exit 1; }; done
 
 # fuzzed_run NAME [auth args...]: learner + 2 actors, the fuzzer for 5 s from the first update.
 fuzzed_run() {
@@ -36,11 +38,18 @@ fuzzed_run() {
   local at_start
   at_start=$(updates_in "$run")
   # 5 s at 200 copies per second, and at least 8 updates made meanwhile.
+  # A watcher on the same wire hears every fuzzed copy too (docs/inputs.md gap 16).
+  "$probe_bin" --url "$url" --all --duration 7 --quiet > "$work/$name.probe.log" 2>&1 &
+  probe_pid=$!
+  started_pids+=("$probe_pid")
   "$fuzz_bin" --url "$url" --rate 200 --duration 5 --seed 7 > "$work/$name.fuzz.log" 2>&1 &
   fuzz_pid=$!
   started_pids+=("$fuzz_pid")
   wait_until 120 "$name: 8 updates under fuzzing" at_least_updates "$run" $((at_start + 8))
   wait "$fuzz_pid" || fail "$name: the fuzzer failed"
+  wait "$probe_pid" || fail "$name: masa_lcm_probe did not exit cleanly under fuzzing: $(tail -n 3 "$work/$name.probe.log")"
+  awk '$1 == "MASA_ROLLOUT" && $2 > 0 { found = 1 } END { exit !found }' "$work/$name.probe.log" ||
+    fail "$name: masa_lcm_probe counted no rollout traffic: $(cat "$work/$name.probe.log")"
   for p in "$learner_pid" "$a0" "$a1"; do kill -0 "$p" 2> /dev/null || fail "$name: a process died under fuzzing"; done
   kill -TERM "$a0" "$a1"
   wait "$a0" || fail "$name: actor 0 did not exit cleanly"
