@@ -1,11 +1,10 @@
 #include "common/config/run_config.hpp"
 
-#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <sstream>
-#include <type_traits>
 
+#include "common/config/config_layers.hpp"
 #include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
 
@@ -13,153 +12,10 @@ namespace masa::config {
 namespace fs = std::filesystem;
 namespace {
 
-const char* kCommandLine = "command line";
-
-bool isOpenSection(const std::string& path) { return path == "env" || path.rfind("env.", 0) == 0; }
-
-std::string join(const std::string& prefix, const std::string& key) { return prefix.empty() ? key : prefix + "." + key; }
-
-std::string kindName(const YAML::Node& n) {
-  switch (n.Type()) {
-    case YAML::NodeType::Map: return "a map";
-    case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Scalar: return "a value";
-    case YAML::NodeType::Null: return "empty";
-    default: return "undefined";
-  }
-}
-
-YAML::Node loadYamlFile(const std::string& path, const std::string& key_for_missing) {
-  if (!fs::exists(path)) throw ConfigError(path, key_for_missing, "file not found");
-  try {
-    return YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(path, "(syntax)", "YAML error at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
-}
-
-// Deep merge without a schema (open sections): maps merge key by key, anything else replaces.
-void mergeOpen(YAML::Node dst, const YAML::Node& src, const std::string& path, const std::string& file,
-               std::map<std::string, std::string>& origin) {
-  for (const auto& kv : src) {
-    const std::string key = kv.first.as<std::string>();
-    if (kv.second.IsMap() && dst[key].IsMap()) {
-      mergeOpen(dst[key], kv.second, join(path, key), file, origin);
-    } else {
-      dst[key] = YAML::Clone(kv.second);
-      origin[join(path, key)] = file;
-    }
-  }
-}
-
 // Keys renamed since runs were first recorded, read under their new name so that old run
 // directories, policy files and configs still load: (old full path, new key in the same section).
 // ppo.max_epochs became ppo.max_updates when the update got one name (issue #32).
-const std::map<std::string, std::string> kRenamedKeys = {{"ppo.max_epochs", "max_updates"}};
-
-// Overlays `src` onto `dst` (a clone of the schema tree), checking every key against `schema`.
-void overlay(YAML::Node dst, const YAML::Node& src, const YAML::Node& schema, const std::string& path,
-             const std::string& file, std::map<std::string, std::string>& origin) {
-  if (!src.IsMap()) throw ConfigError(file, path.empty() ? "(root)" : path, "expected a map, got " + kindName(src));
-  for (const auto& kv : src) {
-    std::string key = kv.first.as<std::string>();
-    if (const auto renamed = kRenamedKeys.find(join(path, key)); renamed != kRenamedKeys.end()) key = renamed->second;
-    const std::string full = join(path, key);
-    const YAML::Node value = kv.second;
-    if (isOpenSection(full)) {
-      if (value.IsMap() && dst[key].IsMap()) {
-        mergeOpen(dst[key], value, full, file, origin);
-      } else {
-        dst[key] = YAML::Clone(value);
-        origin[full] = file;
-      }
-      continue;
-    }
-    const YAML::Node expected = schema[key];
-    if (!expected) {
-      std::string known;
-      for (const auto& s : schema) known += (known.empty() ? "" : ", ") + s.first.as<std::string>();
-      throw ConfigError(file, full, "unknown key (known here: " + known + ")");
-    }
-    if (expected.IsMap()) {
-      overlay(dst[key], value, expected, full, file, origin);
-    } else {
-      if (expected.IsSequence() && !value.IsSequence())
-        throw ConfigError(file, full, "expected a list, got " + kindName(value));
-      if (expected.IsScalar() && !value.IsScalar())
-        throw ConfigError(file, full, "expected a value, got " + kindName(value));
-      dst[key] = YAML::Clone(value);
-      origin[full] = file;
-    }
-  }
-}
-
-// Typed readers that name the origin of the key on failure.
-class Reader {
- public:
-  Reader(const YAML::Node& root, const std::map<std::string, std::string>& origin, std::string defaults_file)
-      : root_(root), origin_(origin), defaults_(std::move(defaults_file)) {}
-
-  YAML::Node node(const std::string& path) const {
-    YAML::Node n;
-    n.reset(root_);  // reset() rebinds; operator= would overwrite the node's contents
-    std::stringstream ss(path);
-    std::string part;
-    while (std::getline(ss, part, '.')) n.reset(n[part]);
-    return n;
-  }
-  std::string originOf(const std::string& path) const {
-    auto it = origin_.find(path);
-    return it == origin_.end() ? defaults_ : it->second;
-  }
-  template <typename T>
-  T get(const std::string& path, const char* what) const {
-    const YAML::Node n = node(path);
-    T v;
-    try {
-      v = n.as<T>();
-    } catch (const YAML::Exception&) {
-      throw ConfigError(originOf(path), path, std::string("expected ") + what + ", got '" + YAML::Dump(n) + "'");
-    }
-    // YAML spells NaN and infinity (.nan, .inf); no setting of a run means either.
-    if constexpr (std::is_floating_point_v<T>) {
-      if (!std::isfinite(v)) throw ConfigError(originOf(path), path, "expected a finite number, got '" + YAML::Dump(n) + "'");
-    }
-    return v;
-  }
-  double positive(const std::string& path) const {
-    const double v = get<double>(path, "a number");
-    if (!(v > 0)) throw ConfigError(originOf(path), path, "must be positive, got " + std::to_string(v));
-    return v;
-  }
-  double nonNegative(const std::string& path) const {
-    const double v = get<double>(path, "a number");
-    if (!(v >= 0)) throw ConfigError(originOf(path), path, "must not be negative, got " + std::to_string(v));
-    return v;
-  }
-  double unitInterval(const std::string& path) const {
-    const double v = get<double>(path, "a number");
-    if (!(v > 0 && v <= 1)) throw ConfigError(originOf(path), path, "must be in (0, 1], got " + std::to_string(v));
-    return v;
-  }
-  int atLeast(const std::string& path, int lo) const {
-    const int v = get<int>(path, "an integer");
-    if (v < lo) throw ConfigError(originOf(path), path, "must be at least " + std::to_string(lo) + ", got " + std::to_string(v));
-    return v;
-  }
-  std::vector<int> widths(const std::string& path, bool allow_empty) const {
-    const auto v = get<std::vector<int>>(path, "a list of integers");
-    if (v.empty() && !allow_empty) throw ConfigError(originOf(path), path, "needs at least one layer width");
-    for (int w : v)
-      if (w < 1) throw ConfigError(originOf(path), path, "layer widths must be positive, got " + std::to_string(w));
-    return v;
-  }
-
- private:
-  const YAML::Node& root_;
-  const std::map<std::string, std::string>& origin_;
-  std::string defaults_;
-};
+const SchemaRules kRunRules{{"env"}, {{"ppo.max_epochs", "max_updates"}}};
 
 // "@x" names a recipe: a file path as given, or configs/recipes/x.yaml.
 std::string resolveRecipe(const std::string& configs_dir, const std::string& name) {
@@ -176,9 +32,8 @@ std::string resolveRecipe(const std::string& configs_dir, const std::string& nam
 
 }  // namespace
 
-void overlayChecked(YAML::Node dst, const YAML::Node& src, const YAML::Node& schema, const std::string& file,
-                    std::map<std::string, std::string>& origin) {
-  overlay(dst, src, schema, "", file, origin);
+ConfigSection sectionOf(const RunConfig& config, const std::string& prefix) {
+  return ConfigSection(config.resolved, config.origin, config.defaults_file, prefix);
 }
 
 std::string defaultConfigsDir() {
@@ -210,7 +65,8 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   const std::string defaults_file = configs_dir + "/defaults.yaml";
   const YAML::Node schema = loadYamlFile(defaults_file, "(file)");
   RunConfig rc;
-  YAML::Node merged = YAML::Clone(schema);
+  rc.defaults_file = defaults_file;
+  ConfigLayers layers(schema, defaults_file, kRunRules);
 
   // Parse overrides first: the task they name decides which task file is read.
   std::vector<std::pair<std::string, YAML::Node>> parsed;
@@ -227,18 +83,8 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
       recipe_files.emplace_back(file, node);
       continue;
     }
-    const auto eq = o.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw ConfigError(kCommandLine, o, "expected key.path=value");
-    const std::string path = o.substr(0, eq);
-    YAML::Node value;
-    try {
-      value = YAML::Load(o.substr(eq + 1));
-    } catch (const YAML::Exception& e) {
-      throw ConfigError(kCommandLine, path, "value is not valid YAML: " + e.msg);
-    }
-    if (path == "task") task = value.as<std::string>();
-    parsed.emplace_back(path, value);
+    parsed.push_back(parseSetting(o));
+    if (parsed.back().first == "task") task = parsed.back().second.as<std::string>();
   }
 
   const std::string task_file = has_base ? base_file : configs_dir + "/tasks/" + task + ".yaml";
@@ -249,29 +95,13 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
         if (e.path().extension() == ".yaml") known += (known.empty() ? "" : ", ") + e.path().stem().string();
     throw ConfigError(task_file, "task", "unknown task '" + task + "' (known: " + known + ")");
   }
-  const YAML::Node task_node = has_base ? base : loadYamlFile(task_file, "task");
-  if (task_node.IsDefined() && !task_node.IsNull()) overlay(merged, task_node, schema, "", task_file, rc.origin);
+  layers.overlay(has_base ? base : loadYamlFile(task_file, "task"), task_file);
+  for (const auto& [file, node] : recipe_files) layers.overlay(node, file);
+  for (const auto& [path, value] : parsed) layers.set(path, value);
+  rc.origin = layers.origin();
+  const YAML::Node merged = layers.tree();
 
-  for (const auto& [file, node] : recipe_files)
-    if (node.IsDefined() && !node.IsNull()) overlay(merged, node, schema, "", file, rc.origin);
-
-  for (const auto& [path, value] : parsed) {
-    // Build {a: {b: value}} and overlay it, so overrides get exactly the file checks.
-    YAML::Node wrapped;
-    wrapped.reset(value);
-    std::vector<std::string> parts;
-    std::stringstream ss(path);
-    std::string part;
-    while (std::getline(ss, part, '.')) parts.push_back(part);
-    for (auto it = parts.rbegin(); it != parts.rend(); ++it) {
-      YAML::Node m(YAML::NodeType::Map);
-      m[*it] = wrapped;
-      wrapped.reset(m);
-    }
-    overlay(merged, wrapped, schema, "", kCommandLine, rc.origin);
-  }
-
-  const Reader r(merged, rc.origin, defaults_file);
+  const ConfigSection r = layers.section();
   rc.task = r.get<std::string>("task", "a task name");
   try {
     rc.method = model::parseMethod(r.get<std::string>("method", "a method name"));
@@ -309,16 +139,13 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   p.minibatch_size = r.atLeast("ppo.minibatch_size", 1);
   p.mini_epochs = r.atLeast("ppo.mini_epochs", 1);
   p.learning_rate = r.positive("ppo.learning_rate");
-  p.lr_schedule = r.get<std::string>("ppo.lr_schedule", "adaptive or fixed");
-  if (p.lr_schedule != "adaptive" && p.lr_schedule != "fixed")
-    throw ConfigError(r.originOf("ppo.lr_schedule"), "ppo.lr_schedule",
-                      "expected 'adaptive' or 'fixed', got '" + p.lr_schedule + "'");
+  p.lr_schedule = r.oneOf("ppo.lr_schedule", {"adaptive", "fixed"});
   p.kl_threshold = r.positive("ppo.kl_threshold");
   p.lr_min = r.positive("ppo.lr_min");
   p.lr_max = r.positive("ppo.lr_max");
   if (p.lr_min > p.lr_max) throw ConfigError(r.originOf("ppo.lr_min"), "ppo.lr_min", "must not exceed ppo.lr_max");
-  p.gamma = r.unitInterval("ppo.gamma");
-  p.tau = r.unitInterval("ppo.tau");
+  p.gamma = r.inRange("ppo.gamma", 0.0, 1.0, true);
+  p.tau = r.inRange("ppo.tau", 0.0, 1.0, true);
   p.e_clip = r.positive("ppo.e_clip");
   p.entropy_coef = r.nonNegative("ppo.entropy_coef");
   p.critic_coef = r.nonNegative("ppo.critic_coef");
@@ -340,10 +167,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   u.silence_warn_s = r.nonNegative("runner.silence_warn_s");
   u.rank_silence_stop_s = r.nonNegative("runner.rank_silence_stop_s");
   u.snapshot_every = r.atLeast("runner.snapshot_every", 0);
-  u.min_batch_fraction = r.positive("runner.min_batch_fraction");
-  if (u.min_batch_fraction > 1.0)
-    throw ConfigError(r.originOf("runner.min_batch_fraction"), "runner.min_batch_fraction",
-                      "must be in (0, 1], got " + std::to_string(u.min_batch_fraction));
+  u.min_batch_fraction = r.inRange("runner.min_batch_fraction", 0.0, 1.0, true);
   u.loss_grace_s = r.positive("runner.loss_grace_s");
   u.repeat_unacknowledged_s = r.nonNegative("runner.repeat_unacknowledged_s");
 

@@ -1,7 +1,8 @@
 // The configuration of a run: configs/defaults.yaml, overridden by configs/tasks/<task>.yaml,
 // overridden by command-line `key.path=value` settings. defaults.yaml is also the schema: a key it
 // does not have is an error (outside open sections such as env), and every error names the file
-// (or "command line") and the key path.
+// (or "command line") and the key path. Read through config_layers.hpp and config_section.hpp, as
+// every other config is.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "common/config/config_section.hpp"
 #include "common/model/actor_critic.hpp"
 
 namespace masa::config {
@@ -73,6 +75,7 @@ struct RunConfig {
   YAML::Node env;         // task parameters, read by the task
   YAML::Node resolved;    // the whole merged tree, for the run directory
   std::map<std::string, std::string> origin;  // key path -> file (or "command line") that set it
+  std::string defaults_file = "configs/defaults.yaml";  // the schema: where keys no layer set come from
 };
 
 // configs_dir holds defaults.yaml, tasks/ and specs/. overrides are "a.b=value" strings where value
@@ -90,11 +93,9 @@ RunConfig loadRunConfigText(const std::string& configs_dir, const std::string& y
 RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<std::string>& overrides,
                             const YAML::Node& base, const std::string& base_file);
 
-// Overlays `src` (read from `file`) onto `dst`, a clone of `schema`: a key the schema does not have,
-// or a map where a value belongs (and the reverse), is a ConfigError naming `file` and the key
-// path. Records in `origin` which file set each key. The rule of run configs, for other configs.
-void overlayChecked(YAML::Node dst, const YAML::Node& src, const YAML::Node& schema, const std::string& file,
-                    std::map<std::string, std::string>& origin);
+// The typed, range-checked reader of one section of the resolved tree ("sac", "offline"), whose
+// errors name the key path and the file that set it (config_section.hpp).
+ConfigSection sectionOf(const RunConfig& config, const std::string& prefix);
 
 // The configs directory of this source tree (MASA_SOURCE_DIR/configs) unless MASA_CONFIGS is set.
 std::string defaultConfigsDir();

@@ -33,7 +33,8 @@ struct OfflineConfig {
   int final_eval_episodes = 100;
 };
 
-// Reads rc.resolved["offline"]; throws masa::ConfigError naming the key and the file that set it.
+// Reads rc.resolved["offline"] (config::sectionOf); throws masa::ConfigError naming the key path
+// (offline.beta) and the file that set it. Every number must be finite.
 OfflineConfig readOfflineConfig(const config::RunConfig& rc);
 
 std::string algoName(Algo algo);  // "bc" | "iql"

@@ -29,7 +29,8 @@ struct SacConfig {
   long long checkpoint_every = 10000;  // env steps; a multiple of log_every (0: only at the end)
 };
 
-// Reads rc.resolved["sac"]; throws masa::ConfigError naming the key and the file that set it.
+// Reads rc.resolved["sac"] (config::sectionOf); throws masa::ConfigError naming the key path
+// (sac.polyak) and the file that set it. Every number must be finite.
 SacConfig readSacConfig(const config::RunConfig& rc);
 
 }  // namespace masa::sac

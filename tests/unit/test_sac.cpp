@@ -10,6 +10,7 @@
 
 #include "common/config/run_config.hpp"
 #include "common/core/config_error.hpp"
+#include "config_error_support.hpp"
 #include "learner/sac/replay_buffer.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_losses.hpp"
@@ -540,6 +541,18 @@ TEST(SacConfigTest, DefaultsReadAndUnknownOrBadKeysAreErrorsNamingTheKey) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("sac.polyak"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("command line"), std::string::npos) << e.what();
+  }
+}
+
+// Before the shared reader (common/config/config_section.hpp) a sac number without a range took
+// NaN and positive() took infinity.
+TEST(SacConfigTest, NaNOrInfinityIsRefusedNamingTheKeyPath) {
+  const std::string configs = std::string(MASA_SOURCE_DIR) + "/configs";
+  for (const std::string set : {"sac.target_entropy_per_dim=.nan", "sac.policy_lr=.inf", "sac.init_alpha=.inf",
+                                "sac.log_std_min=-.inf", "sac.q_lr=.nan"}) {
+    const ConfigError e = test::configErrorOf([&] { readSacConfig(config::loadRunConfig(configs, {"task=a1_beam", set})); });
+    EXPECT_EQ(e.key(), set.substr(0, set.find('='))) << set << ": " << e.what();
+    EXPECT_EQ(e.file(), "command line") << e.what();
   }
 }
 

@@ -1,6 +1,7 @@
 #include "common/sim/yaml/yaml_fields.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "common/core/config_error.hpp"
 
@@ -43,11 +44,15 @@ std::string YamlFields::text(const std::string& key, const std::string& fallback
 
 double YamlFields::number(const std::string& key) const {
   if (!has(key)) fail("", "missing required key '" + key + "'");
+  double v = 0;
   try {
-    return node_[key].as<double>();
+    v = node_[key].as<double>();
   } catch (const YAML::Exception&) {
     fail(key, "expected a number, got '" + YAML::Dump(node_[key]) + "'");
   }
+  // YAML spells NaN and infinity (.nan, .inf); no gain, target or noise of a task means either.
+  if (!std::isfinite(v)) fail(key, "expected a finite number, got '" + YAML::Dump(node_[key]) + "'");
+  return v;
 }
 
 double YamlFields::number(const std::string& key, double fallback) const {

@@ -1,5 +1,6 @@
 #include "common/sim/yaml/yaml_task_config.hpp"
 
+#include <cmath>
 #include <map>
 
 #include "common/sim/yaml/yaml_fields.hpp"
@@ -254,6 +255,7 @@ std::vector<PoseJointConfig> readPose(EnvParams& p) {
     } catch (const YAML::Exception&) {
       failAt(file, j.path, kv.second, "expected a number (rad, or m for a slide joint)");
     }
+    if (!std::isfinite(j.value)) failAt(file, j.path, kv.second, "expected a finite number (rad, or m for a slide joint)");
     out.push_back(j);
   }
   return out;
@@ -316,6 +318,7 @@ HeadingConfig readHeading(EnvParams& p) {
     } catch (const YAML::Exception&) {
       f.fail("direction", "expected numbers");
     }
+    if (!h.direction.allFinite()) f.fail("direction", "expected finite numbers");
     if (h.direction.z() != 0.0 || h.direction.norm() < 1e-9)
       f.fail("direction", "must be a horizontal, non-zero vector (z = 0)");
     h.direction.normalize();
