@@ -12,6 +12,7 @@
 #include "common/model/method.hpp"
 #include "common/sim/registry.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
+#include "learner/sac/sac_policy_file.hpp"
 #include "learner/sac/sac_trainer.hpp"
 #include "tasks/tasks.hpp"
 
@@ -185,8 +186,7 @@ struct SacRun::Impl {
         for (size_t i = 0; i < prog.size(); ++i) e.progress[i] += prog[i] / sc.eval_episodes;
       }
     }
-    std::ofstream f(fs::path(opt.run_dir) / "sac_policy.bin", std::ios::binary);
-    policy.save(f);
+    saveSacPolicyFile((fs::path(opt.run_dir) / "policy.bin").string(), rc, sc, policy, spec);
     return e;
   }
 };
@@ -291,7 +291,7 @@ SacRunResult SacRun::run() {
   }
   result.env_steps = sc.env_steps;
   result.updates = m.trainer.steps();
-  if (m.opt.verbose) std::printf("wrote %s/{config.yaml,metrics.csv,sac_policy.bin,sac_state.bin}\n", m.opt.run_dir.c_str());
+  if (m.opt.verbose) std::printf("wrote %s/{config.yaml,metrics.csv,policy.bin,sac_state.bin}\n", m.opt.run_dir.c_str());
   return result;
 }
 
