@@ -71,7 +71,7 @@ struct SacRun::Impl {
         q_target(spec, twinQMaps(config.method, spec), sc.q_hidden, config.model.activation),
         trainer(policy, q, q_target, sc),
         replay(spec.obsDim(), spec.actDim(), sc.buffer_size) {
-    policy.initialize(rng);
+    policy.initialize(rng, static_cast<float>(rc.model.policy_last_layer_scale));  // 0.01 by default
     q.initialize(rng);
     q_target.moveTowards(q, 1.0f);
     factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, spec, rc.env, rc.origin);
