@@ -51,6 +51,8 @@ class SacSection {
 SacConfig readSacConfig(const config::RunConfig& rc) {
   const SacSection r(rc);
   SacConfig c;
+  c.algorithm = r.get<std::string>("algorithm", "sac or td3");
+  if (c.algorithm != "sac" && c.algorithm != "td3") r.fail("algorithm", "must be sac or td3, got '" + c.algorithm + "'");
   c.env_steps = r.atLeast("env_steps", 1);
   c.buffer_size = r.atLeast("buffer_size", 1);
   c.batch_size = static_cast<int>(r.atLeast("batch_size", 1));
@@ -79,6 +81,13 @@ SacConfig readSacConfig(const config::RunConfig& rc) {
   // A checkpoint is taken at a metrics row, where the row's sums are empty: nothing else to save.
   if (c.checkpoint_every % c.log_every != 0)
     r.fail("checkpoint_every", "must be a multiple of sac.log_every (" + std::to_string(c.log_every) + ")");
+  c.td3_exploration_noise = r.get<double>("td3_exploration_noise", "a number");
+  if (!(c.td3_exploration_noise >= 0)) r.fail("td3_exploration_noise", "must not be negative");
+  c.td3_policy_noise = r.get<double>("td3_policy_noise", "a number");
+  if (!(c.td3_policy_noise >= 0)) r.fail("td3_policy_noise", "must not be negative");
+  c.td3_noise_clip = r.get<double>("td3_noise_clip", "a number");
+  if (!(c.td3_noise_clip >= 0)) r.fail("td3_noise_clip", "must not be negative");
+  c.td3_policy_delay = static_cast<int>(r.atLeast("td3_policy_delay", 1));
   return c;
 }
 

@@ -1,5 +1,6 @@
-// One SAC run in one process: a single environment of a catalog task steps with the policy's
-// samples (uniform random actions for the first sac.learning_starts steps), every transition goes
+// One SAC (or TD3: sac.algorithm) run in one process: a single environment of a catalog task steps
+// with the policy's samples (TD3: tanh(mean) plus Gaussian noise; uniform random actions for the
+// first sac.learning_starts steps), every transition goes
 // into the replay buffer, and once learning started each environment step is followed by
 // sac.updates_per_step gradient steps. The observation normalizer is fitted once, on the random
 // steps, and then held fixed (Q's inputs do not drift). Writes config.yaml, metrics.csv (a row and
