@@ -2,6 +2,7 @@
 //   masa_eval runs/a1_beam_masa_20261130_120000            (a run directory: its policy.bin)
 //   masa_eval tasks/a1_beam/policy/policy.bin --episodes 20 --seed 0
 //   masa_eval runs/x/checkpoint.bin --sample               (a learner checkpoint, next to its config.yaml)
+//   masa_eval runs/a1_sac_masa --seed 1000000              (masa_sac's policy.bin: tanh(mean), its own eval episodes)
 //   xvfb-run -a masa_eval runs/x --video a1.png            (an image strip of episode 0; or .mp4 / .gif)
 //   masa_eval runs/x/checkpoint.bin --save-policy tasks/a1_beam/policy/policy.bin   (ship it)
 // Prints return, length, the task's progress figures (metres along the beam, cube pose error,
@@ -142,7 +143,7 @@ int main(int argc, char** argv) {
   app.add_option("--episodes", o.episodes, "episodes, each reset from its own seed")->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--seed", o.seed, "episode k resets from seed + k")->capture_default_str();
-  app.add_flag("--sample", sample, "sample actions from the policy (default: its mean)");
+  app.add_flag("--sample", sample, "sample actions from the policy (default: its mean; tanh(mean) for a SAC policy, which cannot be sampled)");
   app.add_option("--max-steps", o.max_steps, "cut episodes after this many steps (0: the task's limit)");
   app.add_option("--threads", o.threads, "threads stepping the environments")->capture_default_str()
       ->check(CLI::Range(1, 1024));
@@ -165,9 +166,11 @@ int main(int argc, char** argv) {
     policy::LoadedPolicy p = loadTarget(target, overrides);
     const double sym_error = policy::checkPolicySymmetry(p);
     task::TaskFactory factory(task::taskCatalog(), p.config.task, p.spec, p.config.env, p.config.origin);
+    const bool squashed = p.model->config().squash == model::ActionSquash::kTanh;
+    const char* acting = !o.deterministic ? "sampled" : squashed ? "tanh(mean)" : "mean";
     std::printf("%s / %s from %s, %d episode(s), %s actions, seeds %llu..%llu\n", p.config.task.c_str(),
-                model::methodName(p.config.method).c_str(), target.c_str(), o.episodes,
-                o.deterministic ? "mean" : "sampled", static_cast<unsigned long long>(o.seed),
+                model::methodName(p.config.method).c_str(), target.c_str(), o.episodes, acting,
+                static_cast<unsigned long long>(o.seed),
                 static_cast<unsigned long long>(o.seed + o.episodes - 1));
     if (p.config.method == model::Method::kMasa) std::printf("equivariance checked on load: worst error %.1e\n", sym_error);
     task::PolicyEvaluator evaluator(factory, *p.model);

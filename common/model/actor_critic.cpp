@@ -13,6 +13,8 @@ namespace {
 constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'M', 'O', 'D', '1'};
 }
 
+std::string actionSquashName(ActionSquash s) { return s == ActionSquash::kTanh ? "tanh" : "none"; }
+
 template <typename S>
 ActorCritic<S>::ActorCritic(const sym::SymmetrySpec& spec, const ModelConfig& config)
     : spec_(spec),
@@ -104,8 +106,9 @@ Eigen::Map<const Mat<S>> ActorCritic<S>::actMean(const ConstMatRef<S>& raw_obs) 
   normalizeInput(raw_obs);
   backward_ready_ = false;
   mean_ptr_ = value_ptr_ = nullptr;
-  const S* p = policy_.infer(obs_normalized_.leftCols(batch_)).data();
-  return Eigen::Map<const Mat<S>>(p, actDim(), batch_);
+  auto action = policy_.infer(obs_normalized_.leftCols(batch_));
+  if (config_.squash == ActionSquash::kTanh) action.array() = action.array().tanh();
+  return Eigen::Map<const Mat<S>>(action.data(), actDim(), batch_);
 }
 
 template <typename S>
@@ -162,6 +165,8 @@ void ActorCritic<S>::computeSymmetryLosses() {
 template <typename S>
 void ActorCritic<S>::backward(const ConstMatRef<S>& dmean, const ConstVecRef<S>& dlog_std, const ConstMatRef<S>& dvalue) {
   MASA_CHECK(backward_ready_, "backward() needs a forward() first (actMean/criticValue overwrite its caches)");
+  MASA_CHECK(config_.squash == ActionSquash::kNone,
+             "a squashed (tanh) policy acts only: its Gaussian is SAC's, PPO cannot train it");
   MASA_CHECK(dvalue.rows() == 1 && dvalue.cols() == batch_, "dvalue must be 1 x " << batch_);
   log_std_.backward(dlog_std);
   if (config_.method == Method::kSasa) {

@@ -5,6 +5,10 @@
 // Training use:   forward(raw_obs) -> mean(), logStd(), value()
 //                 backward(dmean, dlog_std, dvalue)   (adds the SASA losses' gradients itself)
 // Acting use:     actMean(raw_obs) and logStd().
+//
+// A model loaded from a squashed policy file (masa_sac's: ModelConfig::squash = kTanh) acts with
+// tanh of the mean, SAC's deterministic action: actMean returns tanh(mean). forward() and mean()
+// stay the Gaussian's (pre-squash) mean, and such a model cannot be trained (backward throws).
 #pragma once
 
 #include <iosfwd>
@@ -23,6 +27,12 @@
 
 namespace masa::model {
 
+// How the deterministic action leaves the policy network: kNone, the Gaussian's mean itself (PPO);
+// kTanh, tanh of it (SAC's squashed Gaussian). Not a config key: a policy file carries it
+// (common/policy/policy_file.hpp), and only masa_sac writes kTanh.
+enum class ActionSquash { kNone, kTanh };
+std::string actionSquashName(ActionSquash s);  // "none" | "tanh"
+
 struct ModelConfig {
   Method method = Method::kMasa;
   std::vector<int> policy_hidden{400, 200, 100};  // Phi
@@ -34,6 +44,7 @@ struct ModelConfig {
   double sasa_policy_coef = 1.0;          // weight of ||T_i A(o) - A(T_i o)||^2
   double sasa_value_coef = 1.0;           // weight of |V(o) - V(T_i o)|
   bool normalize_obs = true;
+  ActionSquash squash = ActionSquash::kNone;  // set from a policy file, never from a config
 };
 
 template <typename S>
@@ -76,7 +87,8 @@ class ActorCritic {
   // Accumulates gradients of the caller's loss (plus the SASA losses for SASA).
   void backward(const ConstMatRef<S>& dmean, const ConstVecRef<S>& dlog_std, const ConstMatRef<S>& dvalue);
 
-  // Mean action only (for actors): no critic work.
+  // The deterministic action only (for actors, evaluation, deployment): no critic work. The mean,
+  // or tanh(mean) for a squashed policy (config().squash).
   Eigen::Map<const Mat<S>> actMean(const ConstMatRef<S>& raw_obs);
   // V(o) only (1 x B, normalized value units): no policy work. Like actMean, it overwrites the
   // caches of forward(), so backward() must follow a fresh forward() (checked).

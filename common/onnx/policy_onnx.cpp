@@ -128,6 +128,7 @@ void addMetadata(onnx::ModelProto& m, const policy::LoadedPolicy& p) {
   add("observation_names", joined(p.spec.obsNames()));
   add("action_names", joined(p.spec.actNames()));
   add("activation", nn::activationName(p.config.model.activation));
+  add("action_squash", model::actionSquashName(p.model->config().squash));
   add("masa_commit", masa::buildCommit());
   add("source_policy", p.source);
 }
@@ -182,16 +183,20 @@ onnx::ModelProto buildPolicyOnnx(const policy::LoadedPolicy& policy) {
     }
   }
   // Phi on every agent at once, then the agents' actions summed through their output maps.
+  // A squashed (SAC) policy's action is tanh of the network's mean: one Tanh node last.
+  const bool squashed = model.config().squash == model::ActionSquash::kTanh;
+  const std::string mean_name = squashed ? "action_before_tanh" : "action_mean";
   const bool needs_output_map = n > 1 || !isIdentity(maps.output[agents[0]]);
-  x = addSharedPolicyNet(g, model, x, static_cast<int>(in), needs_output_map ? "agent_outputs" : "action_mean");
+  x = addSharedPolicyNet(g, model, x, static_cast<int>(in), needs_output_map ? "agent_outputs" : mean_name);
   if (needs_output_map) {
     if (n > 1) {
       g.node("Reshape", {x, g.int64Initializer("agent_columns_shape", {2}, {-1, n * out})}, "agent_outputs_stacked");
       x = "agent_outputs_stacked";
     }
     g.node("MatMul", {x, g.floatInitializer("agent_output_maps", {n * out, maps.act_dim}, stackedOutputMaps(maps, agents))},
-           "action_mean");
+           mean_name);
   }
+  if (squashed) g.node("Tanh", {mean_name}, "action_mean");
   Vec<float> log_std(maps.act_dim);
   model.logStd(log_std);
   g.floatConstant("log_std", {maps.act_dim}, toVector(log_std));

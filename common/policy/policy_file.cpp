@@ -19,7 +19,9 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'P', 'O', 'L', '1'};
-constexpr uint32_t kFormatVersion = 1;
+constexpr uint32_t kFormatPlain = 1;     // the mean is the action
+constexpr uint32_t kFormatSquashed = 2;  // a u32 squash after the version
+constexpr uint32_t kSquashTanh = 1;
 constexpr uint64_t kMaxText = 16u << 20;  // a config or spec larger than this is a corrupt file
 
 void writeText(std::ostream& os, const std::string& s) {
@@ -51,7 +53,12 @@ void savePolicyFile(const std::string& path, const config::RunConfig& rc, const 
   const std::string spec_text = readWholeFile(rc.spec_path);
   std::ostringstream os(std::ios::binary);
   os.write(kMagic, sizeof kMagic);
-  io::writePod(os, kFormatVersion);
+  if (model.config().squash == model::ActionSquash::kNone) {
+    io::writePod(os, kFormatPlain);
+  } else {
+    io::writePod(os, kFormatSquashed);
+    io::writePod(os, kSquashTanh);
+  }
   writeText(os, config::dumpResolved(rc));
   writeText(os, spec_text);
   model.save(os);
@@ -70,9 +77,16 @@ LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_
   if (!is || std::memcmp(magic, kMagic, sizeof magic) != 0)
     throw std::runtime_error(path + ": not a masa policy file (bad magic)");
   uint32_t version = 0;
-  if (!io::readPod(is, version) || version != kFormatVersion)
+  if (!io::readPod(is, version) || (version != kFormatPlain && version != kFormatSquashed))
     throw std::runtime_error(path + ": policy file format " + std::to_string(version) + ", this masa reads " +
-                             std::to_string(kFormatVersion));
+                             std::to_string(kFormatPlain) + " and " + std::to_string(kFormatSquashed));
+  model::ActionSquash squash = model::ActionSquash::kNone;
+  if (version == kFormatSquashed) {
+    uint32_t s = 0;
+    if (!io::readPod(is, s)) throw std::runtime_error(path + ": truncated policy file (squash)");
+    if (s != kSquashTanh) throw std::runtime_error(path + ": unknown action squash " + std::to_string(s) + " (corrupt policy file)");
+    squash = model::ActionSquash::kTanh;
+  }
   LoadedPolicy p;
   p.source = path;
   p.integrity = file.describe();
@@ -84,6 +98,7 @@ LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_
   } catch (const ConfigError& e) {
     throw std::runtime_error(e.what());
   }
+  p.config.model.squash = squash;
   p.model = std::make_unique<model::ActorCritic<float>>(p.spec, p.config.model);
   p.model->load(is, path);
   if (is.peek() != std::char_traits<char>::eof()) throw std::runtime_error(path + ": bytes after the model (corrupt policy file)");

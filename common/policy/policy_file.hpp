@@ -4,8 +4,15 @@
 // model (policy and critic networks, observation and value normalizers).
 //
 // Layout: sealed (common/integrity/sealed_file.hpp: SHA-256, optionally signed), and inside the
-// seal "MASAPOL1", u32 format version, u64 length + config YAML, u64 length + spec YAML, then
-// ActorCritic::save(), nothing after it. Written atomically (tmp + rename).
+// seal "MASAPOL1", u32 format version, [version 2 only: u32 action squash, 1 = tanh], u64 length +
+// config YAML, u64 length + spec YAML, then ActorCritic::save(), nothing after it. Written
+// atomically (tmp + rename).
+//
+// Versions: 1, the mean is the action (every PPO policy; still written for them, so that an older
+// masa reads them); 2, a squash follows the version: tanh for masa_sac's policies, whose
+// deterministic action is tanh(mean) (the loaded model's config().squash, honoured by actMean and
+// the ONNX export). A version 2 file's critic is whatever its writer put there (masa_sac: a zero
+// placeholder, SAC having no V(o)); its log-std is not a sampling noise (sampling is refused).
 #pragma once
 
 #include <memory>

@@ -33,6 +33,9 @@ PolicyEvaluator::PolicyEvaluator(const TaskFactory& factory, model::ActorCritic<
 
 EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook, const TransitionHook& transitions) {
   MASA_CHECK(o.episodes > 0, "evaluation needs at least one episode, got " << o.episodes);
+  // A squashed (SAC) policy's noise depends on the observation and is not in its file.
+  MASA_CHECK(o.deterministic || model_->config().squash == model::ActionSquash::kNone,
+             "a squashed (SAC) policy file holds its deterministic action tanh(mean) only: it cannot be sampled");
   const int n = o.episodes;
   std::vector<std::unique_ptr<Task>> envs(n);
   std::vector<Rng> rngs;

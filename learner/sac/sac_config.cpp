@@ -7,6 +7,7 @@ namespace masa::sac {
 SacConfig readSacConfig(const config::RunConfig& rc) {
   const config::ConfigSection r = config::sectionOf(rc, "sac");
   SacConfig c;
+  c.algorithm = r.oneOf("algorithm", {"sac", "td3"});
   c.env_steps = r.atLeast("env_steps", 1LL);
   c.buffer_size = r.atLeast("buffer_size", 1LL);
   c.batch_size = r.atLeast("batch_size", 1);
@@ -33,6 +34,10 @@ SacConfig readSacConfig(const config::RunConfig& rc) {
   // A checkpoint is taken at a metrics row, where the row's sums are empty: nothing else to save.
   if (c.checkpoint_every % c.log_every != 0)
     r.fail("checkpoint_every", "must be a multiple of sac.log_every (" + std::to_string(c.log_every) + ")");
+  c.td3_exploration_noise = r.nonNegative("td3_exploration_noise");
+  c.td3_policy_noise = r.nonNegative("td3_policy_noise");
+  c.td3_noise_clip = r.nonNegative("td3_noise_clip");
+  c.td3_policy_delay = r.atLeast("td3_policy_delay", 1);
   return c;
 }
 

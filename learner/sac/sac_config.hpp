@@ -1,7 +1,8 @@
 // The `sac` section of a run configuration (configs/defaults.yaml documents every key): the
-// off-policy learner's numbers. defaults.yaml is the schema, so a key it lacks is an error.
+// off-policy learner's numbers, SAC's or TD3's (sac.algorithm). defaults.yaml is the schema, so a key it lacks is an error.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "common/config/run_config.hpp"
@@ -9,6 +10,7 @@
 namespace masa::sac {
 
 struct SacConfig {
+  std::string algorithm = "sac";  // sac | td3 (td3_trainer.hpp)
   long long env_steps = 1000000;
   long long buffer_size = 1000000;
   int batch_size = 256;
@@ -27,6 +29,11 @@ struct SacConfig {
   long long eval_every = 10000;
   int eval_episodes = 5;
   long long checkpoint_every = 10000;  // env steps; a multiple of log_every (0: only at the end)
+  // TD3 only (Fujimoto et al. 2018's numbers).
+  double td3_exploration_noise = 0.1;  // std of the Gaussian added to tanh(mean) when collecting
+  double td3_policy_noise = 0.2;       // std of the target policy smoothing noise
+  double td3_noise_clip = 0.5;         // the smoothing noise clipped to +-this
+  int td3_policy_delay = 2;            // critic steps per actor step (and target move)
 };
 
 // Reads rc.resolved["sac"] (config::sectionOf); throws masa::ConfigError naming the key path

@@ -12,7 +12,9 @@
 #include "common/model/method.hpp"
 #include "common/sim/registry.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
+#include "learner/sac/sac_policy_file.hpp"
 #include "learner/sac/sac_trainer.hpp"
+#include "learner/sac/td3_trainer.hpp"
 #include "tasks/tasks.hpp"
 
 namespace masa::sac {
@@ -28,6 +30,13 @@ std::string duration(double s) {
   else if (s >= 60) std::snprintf(b, sizeof b, "%dm%02ds", static_cast<int>(s / 60), static_cast<int>(s) % 60);
   else std::snprintf(b, sizeof b, "%.0fs", s);
   return b;
+}
+
+std::unique_ptr<OffPolicyTrainer<float>> makeTrainer(const SacConfig& sc, const sym::SymmetrySpec& spec,
+                                                     SacPolicy<float>& policy, offline::TwinQ<float>& q,
+                                                     offline::TwinQ<float>& q_target) {
+  if (sc.algorithm == "td3") return std::make_unique<Td3Trainer<float>>(spec, policy, q, q_target, sc);
+  return std::make_unique<SacTrainer<float>>(policy, q, q_target, sc);
 }
 
 SacPolicyShape policyShape(const config::RunConfig& rc, const SacConfig& sc) {
@@ -50,7 +59,7 @@ struct SacRun::Impl {
   Rng rng;  // initialization, resets, exploration and the learner's noise and samples, in order
   SacPolicy<float> policy;
   offline::TwinQ<float> q, q_target;
-  SacTrainer<float> trainer;
+  std::unique_ptr<OffPolicyTrainer<float>> trainer;  // SAC's or TD3's
   ReplayBuffer replay;
   std::unique_ptr<task::TaskFactory> factory;
   std::unique_ptr<task::Task> env;
@@ -68,11 +77,11 @@ struct SacRun::Impl {
         policy(spec, policyShape(config, sc)),
         q(spec, twinQMaps(config.method, spec), sc.q_hidden, config.model.activation),
         q_target(spec, twinQMaps(config.method, spec), sc.q_hidden, config.model.activation),
-        trainer(policy, q, q_target, sc),
         replay(spec.obsDim(), spec.actDim(), sc.buffer_size) {
-    policy.initialize(rng);
+    policy.initialize(rng, static_cast<float>(rc.model.policy_last_layer_scale));  // 0.01 by default
     q.initialize(rng);
     q_target.moveTowards(q, 1.0f);
+    trainer = makeTrainer(sc, spec, policy, q, q_target);  // after the initialization: TD3 copies the policy
     factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, spec, rc.env, rc.origin);
     env = factory->create();
     progress_names = env->progressNames();
@@ -106,7 +115,7 @@ struct SacRun::Impl {
       std::ofstream f(tmp, std::ios::binary);
       f.write(kMagic, sizeof kMagic);
       io::writePod(f, t_done);
-      trainer.save(f);
+      trainer->save(f);
       replay.save(f);
       std::vector<double> task_state;
       env->saveState(task_state);
@@ -128,7 +137,7 @@ struct SacRun::Impl {
     if (!f || std::string(magic, 8) != std::string(kMagic, 8)) throw std::runtime_error(path.string() + ": not a SAC run state");
     long long n = 0;
     if (!io::readPod(f, t_done)) throw std::runtime_error(path.string() + ": truncated");
-    trainer.load(f);
+    trainer->load(f);
     replay.load(f);
     if (!io::readPod(f, n) || n < 0 || n > (1 << 24)) throw std::runtime_error(path.string() + ": corrupt task state");
     std::vector<double> task_state(static_cast<size_t>(n));
@@ -185,8 +194,7 @@ struct SacRun::Impl {
         for (size_t i = 0; i < prog.size(); ++i) e.progress[i] += prog[i] / sc.eval_episodes;
       }
     }
-    std::ofstream f(fs::path(opt.run_dir) / "sac_policy.bin", std::ios::binary);
-    policy.save(f);
+    saveSacPolicyFile((fs::path(opt.run_dir) / "policy.bin").string(), rc, sc, policy, spec);
     return e;
   }
 };
@@ -200,9 +208,10 @@ SacRunResult SacRun::run() {
   const SacConfig& sc = m.sc;
   const int od = m.spec.obsDim(), ad = m.spec.actDim();
   if (m.opt.verbose)
-    std::printf("%s SAC / %s seed %llu: %lld env steps, %lld random first, %d update(s) per step of batch %d, n-step %d "
+    std::printf("%s %s / %s seed %llu: %lld env steps, %lld random first, %d update(s) per step of batch %d, n-step %d "
                 "-> %s\n",
-                m.rc.task.c_str(), model::methodName(m.rc.method).c_str(), static_cast<unsigned long long>(m.rc.seed),
+                m.rc.task.c_str(), sc.algorithm == "td3" ? "TD3" : "SAC", model::methodName(m.rc.method).c_str(),
+                static_cast<unsigned long long>(m.rc.seed),
                 sc.env_steps, sc.learning_starts, sc.updates_per_step, sc.batch_size, sc.n_step, m.opt.run_dir.c_str());
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
@@ -214,13 +223,13 @@ SacRunResult SacRun::run() {
   long long updates_in_row = 0, episodes_in_row = 0;
   double ret_sum = 0, len_sum = 0;
   SacRunResult result;
-  if (m.opt.resume && m.opt.verbose) std::printf("resumed at env step %lld, update %lld\n", m.t_done, m.trainer.steps());
+  if (m.opt.resume && m.opt.verbose) std::printf("resumed at env step %lld, update %lld\n", m.t_done, m.trainer->steps());
   const long long t_start = m.t_done;  // a resumed run's rate counts the steps of this process only
   for (long long t = m.t_done + 1; t <= sc.env_steps; ++t) {
     if (t <= sc.learning_starts) {
       for (float& a : act) a = uniform(m.rng);
     } else {
-      m.policy.actStochastic(Eigen::Map<const Mat<float>>(obs.data(), od, 1), m.rng, Eigen::Map<Mat<float>>(act.data(), ad, 1));
+      m.trainer->explore(Eigen::Map<const Mat<float>>(obs.data(), od, 1), m.rng, Eigen::Map<Mat<float>>(act.data(), ad, 1));
     }
     const task::StepOutcome out = m.env->step(act.data());
     m.env->observe(next.data());
@@ -239,7 +248,7 @@ SacRunResult SacRun::run() {
     if (t >= sc.learning_starts) {
       for (int u = 0; u < sc.updates_per_step; ++u) {
         m.replay.sample(sc.batch_size, sc.n_step, sc.discount, m.rng, batch);
-        const SacStats s = m.trainer.step(batch, m.rng);
+        const SacStats s = m.trainer->step(batch, m.rng);
         sums.q_loss += s.q_loss;
         sums.actor_loss += s.actor_loss;
         sums.alpha_loss += s.alpha_loss;
@@ -258,7 +267,7 @@ SacRunResult SacRun::run() {
     if (eval_now) e = m.evaluate();
     const double nu = static_cast<double>(std::max<long long>(updates_in_row, 1));
     const double ne = static_cast<double>(episodes_in_row);
-    m.csv << t << ',' << m.trainer.steps() << ',' << wall << ',' << sps << ','
+    m.csv << t << ',' << m.trainer->steps() << ',' << wall << ',' << sps << ','
           << (ne > 0 ? ret_sum / ne : std::nan("")) << ',' << (ne > 0 ? len_sum / ne : std::nan("")) << ','
           << episodes_in_row;
     for (double v : {sums.q_loss, sums.actor_loss, sums.alpha_loss, sums.symmetry_loss, sums.alpha, sums.mean_q, sums.entropy})
@@ -275,7 +284,7 @@ SacRunResult SacRun::run() {
     if (m.opt.verbose) {
       std::printf("env step %lld/%lld (%.0f%%)  %.0f steps/s  elapsed %s  ETA %s  updates %lld", t, sc.env_steps,
                   100.0 * t / sc.env_steps, sps, duration(wall).c_str(), duration((sc.env_steps - t) / sps).c_str(),
-                  m.trainer.steps());
+                  m.trainer->steps());
       if (ne > 0) std::printf("  return %.1f len %.0f (%lld ep)", ret_sum / ne, len_sum / ne, episodes_in_row);
       if (updates_in_row > 0)
         std::printf("  q_loss %.4g  alpha %.3g  entropy %.3g", sums.q_loss / nu, sums.alpha / nu, sums.entropy / nu);
@@ -290,8 +299,8 @@ SacRunResult SacRun::run() {
     if ((sc.checkpoint_every > 0 && t % sc.checkpoint_every == 0) || t == sc.env_steps) m.saveState();
   }
   result.env_steps = sc.env_steps;
-  result.updates = m.trainer.steps();
-  if (m.opt.verbose) std::printf("wrote %s/{config.yaml,metrics.csv,sac_policy.bin,sac_state.bin}\n", m.opt.run_dir.c_str());
+  result.updates = m.trainer->steps();
+  if (m.opt.verbose) std::printf("wrote %s/{config.yaml,metrics.csv,policy.bin,sac_state.bin}\n", m.opt.run_dir.c_str());
   return result;
 }
 

@@ -16,24 +16,24 @@
 
 #include "common/nn/adam.hpp"
 #include "learner/offline/twin_q.hpp"
+#include "learner/sac/off_policy_trainer.hpp"
 #include "learner/sac/replay_buffer.hpp"
 #include "learner/sac/sac_config.hpp"
 #include "learner/sac/sac_policy.hpp"
 
 namespace masa::sac {
 
-struct SacStats {
-  double q_loss = 0, actor_loss = 0, alpha_loss = 0, symmetry_loss = 0;
-  double alpha = 0, mean_q = 0, entropy = 0;  // entropy: -mean log pi of step 2's actions
-};
-
 template <typename S>
-class SacTrainer {
+class SacTrainer : public OffPolicyTrainer<S> {
  public:
   SacTrainer(SacPolicy<S>& policy, offline::TwinQ<S>& q, offline::TwinQ<S>& q_target, const SacConfig& config);
 
-  SacStats step(const ReplayBatch<S>& batch, Rng& rng);
-  long long steps() const { return steps_; }
+  // A sample of the squashed Gaussian (SacPolicy::actStochastic).
+  void explore(const ConstMatRef<S>& raw_obs, Rng& rng, MatRef<S> actions) override {
+    policy_->actStochastic(raw_obs, rng, actions);
+  }
+  SacStats step(const ReplayBatch<S>& batch, Rng& rng) override;
+  long long steps() const override { return steps_; }
   S logAlpha() const { return log_alpha_.values()(0); }
   double alpha() const;
   double targetEntropy() const { return target_entropy_; }
@@ -48,8 +48,8 @@ class SacTrainer {
   // Everything a resumed run needs to take the same next step: the policy (with its normalizer),
   // Q, Q', log alpha, the three Adams and the step count. The replay buffer and the generators are
   // the caller's.
-  void save(std::ostream& os) const;
-  void load(std::istream& is);
+  void save(std::ostream& os) const override;
+  void load(std::istream& is) override;
 
  private:
   SacPolicy<S>* policy_;

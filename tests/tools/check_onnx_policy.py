@@ -102,13 +102,22 @@ def check(onnx_path, reference_path, tolerance):
     if len(metadata["observation_names"].split(",")) != obs_dim:
         return f"metadata names {len(metadata['observation_names'].split(','))} observations, not {obs_dim}"
 
+    # A squashed (SAC) policy's action is a Tanh's output, the last node on the way to action_mean.
+    squash = metadata.get("action_squash", "none")
+    if squash == "tanh":
+        producers = [n for n in model.graph.node if "action_mean" in n.output]
+        if len(producers) != 1 or producers[0].op_type != "Tanh":
+            return "metadata action_squash is tanh, but action_mean is not the output of a Tanh node"
+    elif squash != "none":
+        return f"metadata action_squash '{squash}' is neither none nor tanh"
+
     out = evaluate(model, obs)
     mean_error = np.max(np.abs(out["action_mean"] - masa_mean))
     log_std_error = np.max(np.abs(out["log_std"] - masa_log_std))
     # The batch is free: one sample alone gives its row of the batch.
     single = evaluate(model, obs[-1:])["action_mean"]
     batch_error = np.max(np.abs(single - out["action_mean"][-1:]))
-    summary = (f"{metadata['task']} {metadata['method']}, {len(model.graph.node)} nodes, {len(obs)} samples: "
+    summary = (f"{metadata['task']} {metadata['method']} (squash {squash}), {len(model.graph.node)} nodes, {len(obs)} samples: "
                f"action_mean max |onnx - masa| {mean_error:.2e}, log_std {log_std_error:.2e}, "
                f"batch of 1 {batch_error:.2e} (tolerance {tolerance:g}, |action_mean| up to {np.max(np.abs(masa_mean)):.2f})")
     if not (mean_error <= tolerance and log_std_error <= tolerance and batch_error <= tolerance):

@@ -4,7 +4,8 @@
 # (onnx's checker, then a numpy walk over the graph) to 1e-5:
 #   - every shipped policy (all MASA: C2 mirrors, the TriFinger's C3 and the Ant's C4 rotations);
 #   - tiny runs of the other methods, one update each: SA (ELU), SASA (tanh), MA (ReLU, one-hot ids)
-#     and SA without the observation normalizer.
+#     and SA without the observation normalizer;
+#   - tiny masa_sac runs (MASA normalized, SA not), whose action_mean is tanh(mean).
 # usage: onnx_export_matches_masa.sh BUILD_DIR WORK_DIR
 # Prints PASS or FAIL lines; exits 77 (skip) when /usr/bin/python3 has no onnx (python3-onnx).
 set -uo pipefail
@@ -24,6 +25,22 @@ for case in "sa elu true" "sasa tanh true" "ma relu true" "sa elu false"; do
   if ! "$build/tools/masa_train" "${tiny[@]}" --set method=$method --set model.activation=$activation \
        --set model.normalize_input=$normalize --quiet --updates 1 --run-dir "$run" > "$run.log" 2>&1; then
     echo "FAIL: the tiny $method run did not train:"; tail -5 "$run.log"; exit 1
+  fi
+  policies+=("$run/policy.bin")
+done
+
+# masa_sac's policies (format 2: action_mean = tanh(mean), a Tanh node last), with a large last
+# layer so that the means reach beyond tanh's linear range: MASA after 100 updates (normalized),
+# SA before any (learning_starts not reached: no normalizer).
+sac_tiny=(--task a1_beam --set "sac.policy_hidden=[16,8]" --set "sac.q_hidden=[8]" --set sac.batch_size=8
+          --set sac.log_every=20 --set sac.eval_every=0 --set sac.eval_episodes=1 --set sac.checkpoint_every=0
+          --set env.max_episode_steps=20 --set model.policy_last_layer_scale=3)
+for case in "masa 40 140" "sa 100 60"; do
+  read -r method starts steps <<< "$case"
+  run="$work/tiny_sac_${method}"
+  if ! "$build/tools/masa_sac" "${sac_tiny[@]}" --method $method --set sac.learning_starts=$starts --steps $steps \
+       --quiet --out "$run" > "$run.log" 2>&1; then
+    echo "FAIL: the tiny SAC $method run did not train:"; tail -5 "$run.log"; exit 1
   fi
   policies+=("$run/policy.bin")
 done
