@@ -107,12 +107,11 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
   for (int e = 0; e < num_envs_; ++e) envs_[e]->reset(rngs_[e]);
 
   if (!transport_) {
-    owned_transport_ =
-        std::make_unique<transport::Transport>(options_.url.empty() ? transport::loopbackUrl() : options_.url, options_.run_key);
+    owned_transport_ = makeTransport(options_.url.empty() ? transport::loopbackUrl() : options_.url);
     transport_ = owned_transport_.get();
   }
   if (!options_.rollout_url.empty() && options_.rollout_url != transport_->url())
-    rollout_transport_ = std::make_unique<transport::Transport>(options_.rollout_url, options_.run_key);
+    rollout_transport_ = makeTransport(options_.rollout_url);
   char host[256] = {};
   if (gethostname(host, sizeof host - 1) == 0) hostname_ = host;
   transport_->subscribe<masa::lcmt_policy_params>(
@@ -120,6 +119,11 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
 }
 
 Actor::~Actor() = default;
+
+std::unique_ptr<transport::Transport> Actor::makeTransport(const std::string& url) const {
+  if (options_.signed_mode) return std::make_unique<transport::Transport>(url, *options_.signed_mode);
+  return std::make_unique<transport::Transport>(url, options_.run_key);
+}
 
 void Actor::onParams(const masa::lcmt_policy_params& m) {
   if (!params_check_->ofThisRun(m)) return;  // another run on the same network

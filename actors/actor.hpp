@@ -46,6 +46,8 @@ struct ActorOptions {
   // Authenticates every message (common/transport/message_auth.hpp): the learner's run key. None:
   // unsigned (--no-auth). Ignored with an external transport.
   std::optional<transport::RunKey> run_key;
+  // A signed run instead (common/transport/message_sign.hpp): this actor's key and the run's roster.
+  std::optional<transport::SignedMode> signed_mode;
   int64_t max_rollouts = -1;     // < 0: until stopped
   int threads = 1;               // OpenMP threads over environments
   bool start_without_learner = false;  // act with own initial parameters as version 0
@@ -134,6 +136,7 @@ class Actor {
 
  private:
   void onParams(const masa::lcmt_policy_params& msg);
+  std::unique_ptr<transport::Transport> makeTransport(const std::string& url) const;
   void rejectParams(int64_t version, const std::string& why);
   void swapInPending();
   bool stopRequested() const { return options_.stop && options_.stop->load(std::memory_order_relaxed); }

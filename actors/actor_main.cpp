@@ -2,6 +2,8 @@
 // the parameters the learner broadcasts for --run-id, and streams rollouts back over LCM.
 //   masa_actor --set task=a1_beam --actor-id 0 --num-envs 64 --run-id 42 --key-file RUN_DIR/run.key
 // Every message is authenticated with the learner's run key (--key-file); --no-auth turns that off.
+// In a signed run, --roster RUN_DIR/roster --signing-key RUN_DIR/keys/actorN.key instead: the actor
+// signs with its own key and believes parameters only from the roster's learner.
 // Exit status 0 on a clean stop (SIGINT/SIGTERM or --max-rollouts), 2 on bad input.
 #include <atomic>
 #include <chrono>
@@ -82,8 +84,14 @@ int main(int argc, char** argv) {
   bool no_auth = false;
   auto* key_opt = app.add_option("--key-file", key_file,
                                  "the learner's run key (its RUN_DIR/run.key), which every message is authenticated with");
-  app.add_flag("--no-auth", no_auth, "send and accept messages without authentication (anyone on the network can "
+  auto* no_auth_opt = app.add_flag("--no-auth", no_auth, "send and accept messages without authentication (anyone on the network can "
                                      "then make this actor act with their parameters)")->excludes(key_opt);
+  std::string roster_file, signing_key;
+  auto* roster_opt = app.add_option("--roster", roster_file,
+                                    "a signed run: the run's roster (public keys and channels per sender, masa_roster)")
+                         ->excludes(key_opt)->excludes(no_auth_opt);
+  app.add_option("--signing-key", signing_key, "a signed run: this actor's private key file (mode 0600)")->needs(roster_opt);
+  roster_opt->needs("--signing-key");
   // Fault injection for tests of the learner's loss handling; never for training.
   app.add_option("--drop-chunks-percent", opt.drop_chunks_percent,
                  "FAULT INJECTION (tests only): throw away this percentage of rollout chunks instead of sending them")
@@ -114,7 +122,7 @@ int main(int argc, char** argv) {
       job->abort(2);
     }
   }
-  if (key_file.empty() && !no_auth) {
+  if (key_file.empty() && !no_auth && roster_file.empty()) {
     std::fprintf(stderr, "masa_actor: no run key: give --key-file RUN_DIR/run.key (the learner's), or --no-auth to "
                          "run without message authentication\n");
     return 2;
@@ -129,6 +137,12 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "masa_actor %d: actor %d of %d in an MPI job, rollouts to learner rank %d on %s\n",
                    opt.actor_id, opt.actor_id, job->actorCount(), opt.actor_id % job->learnerCount(),
                    opt.rollout_url.c_str());
+    } else if (!roster_file.empty()) {
+      opt.signed_mode = masa::transport::loadSignedMode(
+          roster_file, signing_key, {masa::transport::Role::kActor, static_cast<uint32_t>(opt.actor_id)});
+      std::fprintf(stderr, "masa_actor %d: messages signed with %s (%s), senders checked against the roster %s\n",
+                   opt.actor_id, signing_key.c_str(),
+                   masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()).c_str(), roster_file.c_str());
     } else if (no_auth) {
       std::fprintf(stderr, "masa_actor %d: WARNING: --no-auth: messages are neither signed nor checked; anyone who "
                            "can reach this network can make this actor act with their parameters\n", opt.actor_id);

@@ -7,10 +7,16 @@
 //           learner sends it), once per update and on every periodic repeat;
 //   Bytes/N: plain buffers, for the cost's slope in the size.
 // bytes_per_second is SHA-256's throughput here; time per message is the cost.
+// Sign*/Verify* do the same for a signed run's SIG1 trailer (common/transport/message_sign.hpp):
+// Ed25519 by the sender's own key over a SHA-256 of the message, counter and sender; Verify* is
+// the receiver's whole check (roster, permission, signature; not the counter window, which is a
+// few bit operations).
 //   build/bench/bench_message_auth --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <filesystem>
+#include <unistd.h>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -22,6 +28,7 @@
 #include "common/rollout/rollout.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/message_auth.hpp"
+#include "common/transport/message_sign.hpp"
 #include "actors/rollout_chunker.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
@@ -103,6 +110,70 @@ BENCHMARK_CAPTURE(BM_SealPolicy, a1_beam, std::string("a1_beam"))->Unit(benchmar
 BENCHMARK_CAPTURE(BM_OpenPolicy, a1_beam, std::string("a1_beam"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_SealPolicy, humanoid_tightrope, std::string("humanoid_tightrope"))->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_OpenPolicy, humanoid_tightrope, std::string("humanoid_tightrope"))->Unit(benchmark::kMicrosecond);
+
+// A learner's and an actor's key in a temporary directory, and their roster.
+struct Keys {
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("masa_bench_sign_" + std::to_string(::getpid()));
+  std::shared_ptr<transport::Roster> roster = std::make_shared<transport::Roster>();
+  std::shared_ptr<transport::MessageSigner> learner, actor;
+  Keys() {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const transport::SenderId l{transport::Role::kLearner, 0}, a{transport::Role::kActor, 0};
+    roster->add(l, integrity::generateKeyPair((dir / "l.key").string(), (dir / "l.pub").string()), transport::defaultChannels(l.role));
+    roster->add(a, integrity::generateKeyPair((dir / "a.key").string(), (dir / "a.pub").string()), transport::defaultChannels(a.role));
+    learner = transport::MessageSigner::load((dir / "l.key").string(), l, *roster);
+    actor = transport::MessageSigner::load((dir / "a.key").string(), a, *roster);
+    std::filesystem::remove_all(dir);
+  }
+};
+
+void signEach(benchmark::State& state, const std::vector<uint8_t>& message, const char* channel, bool as_learner) {
+  Keys keys;
+  transport::MessageSigner& signer = as_learner ? *keys.learner : *keys.actor;
+  uint8_t trailer[transport::kSigTrailerBytes];
+  for (auto _ : state) {
+    signer.seal(channel, message.data(), static_cast<int>(message.size()), trailer);
+    benchmark::DoNotOptimize(trailer);
+  }
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations()) * static_cast<int64_t>(message.size()));
+  state.counters["message_bytes"] = static_cast<double>(message.size());
+}
+
+void verifyEach(benchmark::State& state, const std::vector<uint8_t>& message, const char* channel, bool as_learner) {
+  Keys keys;
+  const transport::MessageVerifier verifier(keys.roster);
+  std::vector<uint8_t> signed_bytes(message);
+  signed_bytes.resize(message.size() + transport::kSigTrailerBytes);
+  (as_learner ? *keys.learner : *keys.actor)
+      .seal(channel, message.data(), static_cast<int>(message.size()), signed_bytes.data() + message.size());
+  for (auto _ : state) {
+    const transport::OpenedMessage m = verifier.open(channel, signed_bytes.data(), static_cast<int>(signed_bytes.size()));
+    if (m.verdict != transport::WireVerdict::kOk) state.SkipWithError("a signed message did not verify");
+    benchmark::DoNotOptimize(m);
+  }
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations()) * static_cast<int64_t>(message.size()));
+  state.counters["message_bytes"] = static_cast<double>(message.size());
+}
+
+void BM_SignChunk(benchmark::State& state) { signEach(state, rolloutChunk(), transport::kRolloutChannel, false); }
+void BM_VerifyChunk(benchmark::State& state) { verifyEach(state, rolloutChunk(), transport::kRolloutChannel, false); }
+BENCHMARK(BM_SignChunk)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_VerifyChunk)->Unit(benchmark::kMicrosecond);
+void BM_SignPolicy(benchmark::State& state, const std::string& recipe) {
+  signEach(state, policyMessage(recipe), transport::kPolicyChannel, true);
+}
+void BM_VerifyPolicy(benchmark::State& state, const std::string& recipe) {
+  verifyEach(state, policyMessage(recipe), transport::kPolicyChannel, true);
+}
+BENCHMARK_CAPTURE(BM_SignPolicy, a1_beam, std::string("a1_beam"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_VerifyPolicy, a1_beam, std::string("a1_beam"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_SignPolicy, humanoid_tightrope, std::string("humanoid_tightrope"))->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_VerifyPolicy, humanoid_tightrope, std::string("humanoid_tightrope"))->Unit(benchmark::kMicrosecond);
+void BM_VerifyBytes(benchmark::State& state) {
+  verifyEach(state, std::vector<uint8_t>(static_cast<std::size_t>(state.range(0)), 0x5a), transport::kHeartbeatChannel, false);
+}
+BENCHMARK(BM_VerifyBytes)->Arg(200)->Unit(benchmark::kMicrosecond);
 
 void BM_SealBytes(benchmark::State& state) {
   sealEach(state, std::vector<uint8_t>(static_cast<std::size_t>(state.range(0)), 0x5a), transport::kHeartbeatChannel);

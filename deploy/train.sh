@@ -12,9 +12,14 @@
 #                   on a cluster, started by deploy/cluster/mpirun_train.sh; L must divide K and E*K)
 # FILE has one host per line, "host [actors] [envs]" (default 1 actor of E environments), '#'
 # comments; "localhost" runs its actors here without ssh. See deploy/hosts.example.
-# Every message is authenticated with the run's key, RUN_DIR/run.key (made here before anything
-# starts, kept on --resume, carried to each host over the remote shell's stdin); --no-auth runs
-# without (docs/reliability.md, "Message authentication").
+# Every message is signed (--auth signed, the default): each process has its own Ed25519 key,
+# RUN_DIR/keys/<role><index>.key (mode 0600), and RUN_DIR/roster says whose key may publish on which
+# channel (the learner's alone on MASA_POLICY, each actor's on its own rollouts and heartbeats), so a
+# stolen actor key can neither forge parameters nor another actor's rollouts; both are made here by
+# masa_roster before anything starts, kept on --resume, and with --hosts each host gets the roster
+# and only its own actors' keys, over the remote shell's stdin. --auth hmac authenticates with one
+# run key, RUN_DIR/run.key, shared by all (any holder can forge anything; no replay protection);
+# --no-auth (--auth none) runs without (docs/reliability.md, "Message authentication").
 # MASA_BUILD_DIR (default build) and MASA_RUNS_DIR (default runs) choose the folders, MASA_LCM_URL
 # the LCM URL (default: multicast with the largest receive buffer the kernel allows). With --hosts:
 #   MASA_REMOTE_SHELL      how to run a command on a host (default "ssh -o BatchMode=yes"); it is
@@ -30,7 +35,7 @@ cd "$(dirname "$0")/.."
 task=a1_beam method=masa task_given=0 method_given=0
 [ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; task_given=1; shift; }
 [ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; method_given=1; shift; }
-actors=2 envs=32 envs_given=0 updates="" hosts_file="" actors_given=0 resume="" recipe="" run_dir_given="" no_auth=0 ranks=1
+actors=2 envs=32 envs_given=0 updates="" hosts_file="" actors_given=0 resume="" recipe="" run_dir_given="" auth_mode=signed ranks=1
 sets=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -42,18 +47,27 @@ while [ $# -gt 0 ]; do
     --updates) updates=$2; shift 2 ;;
     --hosts) hosts_file=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
-    --no-auth) no_auth=1; shift ;;
+    --no-auth) auth_mode=none; shift ;;
+    --auth) auth_mode=$2; shift 2 ;;
     --ranks) ranks=$2; shift 2 ;;
     *) echo "train.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
+
+case "$auth_mode" in
+  signed | hmac | none) ;;
+  *) echo "train.sh: --auth '$auth_mode': expected signed, hmac or none" >&2; exit 2 ;;
+esac
+no_auth=0
+[ "$auth_mode" = none ] && no_auth=1
 
 for pair in "--actors:$actors" "--envs:$envs" ${updates:+"--updates:$updates"} "--ranks:$ranks"; do
   [[ ${pair#*:} =~ ^[1-9][0-9]*$ ]] || { echo "train.sh: ${pair%%:*} '${pair#*:}' is not a positive count" >&2; exit 2; }
 done
 
 build=${MASA_BUILD_DIR:-build}
-for bin in "$build/learner/masa_learner" "$build/actors/masa_actor" "$build/tools/masa_config"; do
+for bin in "$build/learner/masa_learner" "$build/actors/masa_actor" "$build/tools/masa_config" \
+           $([ "$auth_mode" = signed ] && [ "$ranks" = 1 ] && echo "$build/tools/masa_roster"); do
   [ -x "$bin" ] || { echo "train.sh: $bin is missing: run scripts/build.sh first" >&2; exit 2; }
 done
 
@@ -91,6 +105,8 @@ if [ "$ranks" -gt 1 ]; then
   (( actors % ranks == 0 )) || { echo "train.sh: $actors actors do not divide among $ranks learner ranks (each rank takes its share)" >&2; exit 2; }
   job=("$task" "$method" --ranks "$ranks" --actors "$actors" --envs "$envs" --updates "$updates")
   [ "$no_auth" = 0 ] || job+=(--no-auth)
+  # An MPI job's processes take the run key from learner rank 0 over MPI: signed runs are one learner.
+  [ "$auth_mode" != signed ] || echo "train.sh: --ranks: messages authenticated with the job's run key (HMAC), not signed per process" >&2
   if [ -n "$resume" ]; then
     for f in checkpoint.bin config.yaml; do
       [ -r "$resume/$f" ] || { echo "train.sh: $resume/$f is missing: not a run directory" >&2; exit 2; }
@@ -179,14 +195,27 @@ else
   fi
 fi
 
-# The run key, before anything starts: the learner and every actor read it at start-up.
-if [ "$no_auth" = 1 ]; then
+# The keys, before anything starts: the learner and every actor read theirs at start-up. Only
+# file paths go on command lines, never a key.
+if [ "$auth_mode" = none ]; then
   auth=(--no-auth)
   echo "train.sh: WARNING: --no-auth: messages are not authenticated; anyone on the network can feed this run" >&2
-else
+elif [ "$auth_mode" = hmac ]; then
   bash deploy/run_key.sh "$run_dir/run.key"
   auth=(--key-file "$run_dir/run.key")
+else
+  "$build/tools/masa_roster" make "$run_dir" --actors "$actors" > /dev/null ||
+    { echo "train.sh: cannot make the keys and roster in $run_dir" >&2; exit 2; }
+  auth=(--roster "$run_dir/roster" --signing-key "$run_dir/keys/learner0.key")
 fi
+# The options that give actor $1 its key.
+actor_auth() {
+  if [ "$auth_mode" = signed ]; then
+    actor_auth_args=(--roster "$run_dir/roster" --signing-key "$run_dir/keys/actor$1.key")
+  else
+    actor_auth_args=("${auth[@]}")
+  fi
+}
 
 # Keep-alive pipe: every actor's and the learner's tethered.sh reads it on stdin, and only this
 # script holds its write end (children close it), so when this script ends in any way, even by
@@ -207,8 +236,9 @@ if [ -z "$hosts_file" ]; then
   learner=$!
   pids=()
   for ((a = 0; a < actors; ++a)); do
+    actor_auth "$a"
     OMP_NUM_THREADS=1 bash deploy/tethered.sh "$build/actors/masa_actor" "${actor_config[@]+"${actor_config[@]}"}" \
-      "${common[@]+"${common[@]}"}" --url "$url" --run-id "$run_id" "${auth[@]}" --actor-id "$a" --num-envs "$envs" \
+      "${common[@]+"${common[@]}"}" --url "$url" --run-id "$run_id" "${actor_auth_args[@]}" --actor-id "$a" --num-envs "$envs" \
       <&"$alive_in" >> "$run_dir/actor$a.log" 2>&1 {keep}>&- {alive_in}<&- &
     pids+=($!)
   done
@@ -240,7 +270,25 @@ echo "train.sh: $task / $method over $url, $actors actors on ${#hosts[@]} hosts 
 # The run key goes to each actor host before anything starts, on the remote shell's stdin (never on
 # a command line: `ps` shows those), to the same path under MASA_REMOTE_DIR, mode 0600. Written
 # under a temporary name and renamed: a host that shares this file system keeps the one key.
-if [ "$no_auth" = 0 ]; then
+# Signed: each host gets the roster (public) and the keys of its own actors only, the same way.
+if [ "$auth_mode" = signed ]; then
+  carry_file() {  # host, file under run_dir, umask
+    local q
+    q=$(printf %q "$run_dir/$2")
+    "${remote_shell[@]}" "$1" "cd $(printf %q "$remote_dir") && umask $3 && mkdir -p $(printf %q "$run_dir/keys") && cat > $q.tmp.\$\$ && mv -f $q.tmp.\$\$ $q" \
+      < "$run_dir/$2" || { echo "train.sh: cannot carry $2 to $1 (to $remote_dir/$run_dir/$2 there)" >&2; exit 2; }
+  }
+  a=0
+  for i in "${!hosts[@]}"; do
+    h=${hosts[i]}
+    if [ "$h" != localhost ]; then
+      carry_file "$h" roster 077
+      for ((k = 0; k < host_actors[i]; ++k)); do carry_file "$h" "keys/actor$((a + k)).key" 077; done
+    fi
+    a=$((a + host_actors[i]))
+  done
+fi
+if [ "$auth_mode" = hmac ]; then
   for h in $(printf '%s\n' "${hosts[@]}" | sort -u); do
     [ "$h" = localhost ] && continue
     key_q=$(printf %q "$run_dir/run.key")
@@ -262,7 +310,8 @@ for i in "${!hosts[@]}"; do
     # localhost: this repository and build; another host: MASA_REMOTE_DIR and MASA_REMOTE_BUILD_DIR there.
     dir=$remote_dir bin_dir=$remote_build
     [ "$h" = localhost ] && dir=$PWD bin_dir=$build
-    actor_cmd=("$bin_dir/actors/masa_actor" "${common[@]}" --url "$url" --run-id "$run_id" "${auth[@]}" --actor-id "$a"
+    actor_auth "$a"
+    actor_cmd=("$bin_dir/actors/masa_actor" "${common[@]}" --url "$url" --run-id "$run_id" "${actor_auth_args[@]}" --actor-id "$a"
                --num-envs "${host_envs[i]}")
     cmd="cd $(printf %q "$dir") && exec env OMP_NUM_THREADS=1 bash deploy/tethered.sh $(printf '%q ' "${actor_cmd[@]}")"
     log="$run_dir/actor$a.log"

@@ -114,9 +114,8 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   assembler_->setLearnerVersion(updates_);
 
   const std::string intake_url = opt_.rollout_url.empty() ? opt_.url : opt_.rollout_url;
-  transport_ = std::make_unique<transport::Transport>(intake_url, opt_.run_key);
-  if (isLeadRank() && intake_url != opt_.url)
-    policy_transport_ = std::make_unique<transport::Transport>(opt_.url, opt_.run_key);
+  transport_ = makeTransport(intake_url);
+  if (isLeadRank() && intake_url != opt_.url) policy_transport_ = makeTransport(opt_.url);
   transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
   // Actors acknowledge parameters in their heartbeats, which they send on the parameters' URL:
   // rank 0 hears every actor of a data-parallel job there, not only those that feed its own URL.
@@ -159,10 +158,22 @@ double Learner::wallTime() const {
   return wall_offset_s_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
+std::unique_ptr<transport::Transport> Learner::makeTransport(const std::string& url) const {
+  if (opt_.signed_mode) return std::make_unique<transport::Transport>(url, *opt_.signed_mode);
+  return std::make_unique<transport::Transport>(url, opt_.run_key);
+}
+
 DropStats Learner::dropStats() const {
   DropStats s = assembler_->stats();
-  s.count[static_cast<int>(DropReason::kUnauthenticated)] =
-      transport_->rejected(transport::kRolloutChannel)[static_cast<int>(transport::WireVerdict::kUnauthenticated)];
+  using transport::WireVerdict;
+  const transport::WireRejects refused = transport_->rejected(transport::kRolloutChannel);
+  for (const auto& [reason, verdict] : {std::pair{DropReason::kUnauthenticated, WireVerdict::kUnauthenticated},
+                                        std::pair{DropReason::kUnknownSender, WireVerdict::kUnknownSender},
+                                        std::pair{DropReason::kNotPermitted, WireVerdict::kNotPermitted},
+                                        std::pair{DropReason::kClaimsAnotherActor, WireVerdict::kClaimsAnotherSender},
+                                        std::pair{DropReason::kReplayed, WireVerdict::kReplayed},
+                                        std::pair{DropReason::kBeyondWindow, WireVerdict::kBeyondWindow}})
+    s.count[static_cast<int>(reason)] = refused[static_cast<int>(verdict)];
   return s;
 }
 

@@ -48,6 +48,9 @@ struct LearnerOptions {
   // Authenticates every message (common/transport/message_auth.hpp); none: unsigned (--no-auth,
   // or in-process memq runs).
   std::optional<transport::RunKey> run_key;
+  // A signed run instead (common/transport/message_sign.hpp): the learner's own key and the run's
+  // roster; run_key is then unused.
+  std::optional<transport::SignedMode> signed_mode;
   bool verbose = true;  // one progress line per update on stdout
   // Data-parallel (docs/scaling.md): this process is learner rank ranks->rank() of ranks->size(),
   // taking ppo.num_envs / size environments of every batch from the actors that send to its
@@ -114,6 +117,7 @@ class Learner {
   const UpdateReport& lastReport() const { return report_; }
 
  private:
+  std::unique_ptr<transport::Transport> makeTransport(const std::string& url) const;
   void onChunk(const void* data, int size);
   void onHeartbeat(const masa::lcmt_actor_heartbeat& m);
   // How long step() may wait for traffic: at most timeout_ms, less when a short batch or a repeat

@@ -3,7 +3,9 @@
 //   masa_learner --set task=trifinger_lift --set method=masa
 //   masa_learner --resume runs/trifinger_lift_masa_0_20260101-120000
 // Every message is authenticated with the run key (--key-file, default RUN_DIR/run.key, made when
-// missing); --no-auth turns that off.
+// missing); --no-auth turns that off. In a signed run (--roster RUN_DIR/roster --signing-key
+// RUN_DIR/keys/learner0.key, made by masa_roster), the learner signs with its own key and believes
+// only the roster's actors on their own channels (common/transport/message_sign.hpp).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -76,8 +78,15 @@ int main(int argc, char** argv) {
   auto* key_opt = app.add_option("--key-file", key_file,
                                  "the run key every message is authenticated with (default: RUN_DIR/run.key, made "
                                  "when missing; give the actors the same file)");
-  app.add_flag("--no-auth", no_auth, "send and accept messages without authentication (anyone on the network can "
+  auto* no_auth_opt = app.add_flag("--no-auth", no_auth, "send and accept messages without authentication (anyone on the network can "
                                      "then feed this run rollouts)")->excludes(key_opt);
+  std::string roster_file, signing_key;
+  auto* roster_opt = app.add_option("--roster", roster_file,
+                                    "a signed run: the run's roster (public keys and channels per sender, masa_roster)")
+                         ->excludes(key_opt)->excludes(no_auth_opt);
+  app.add_option("--signing-key", signing_key, "a signed run: this learner's private key file (mode 0600)")
+      ->needs(roster_opt);
+  roster_opt->needs("--signing-key");
   int rank_check_every = 10;
   app.add_option("--rank-check-every", rank_check_every,
                  "data-parallel ranks compare parameter hashes every this many updates")
@@ -113,7 +122,13 @@ int main(int argc, char** argv) {
       ranks->broadcast(dir, 0);
       opt.run_dir.assign(dir.begin(), dir.end());
     }
-    if (no_auth) {
+    if (!roster_file.empty()) {
+      if (ranks) throw std::runtime_error("--roster: signed runs have one learner process (ranks use the MPI job's run key)");
+      opt.signed_mode = masa::transport::loadSignedMode(roster_file, signing_key, {masa::transport::Role::kLearner, 0});
+      std::cout << "masa_learner: messages signed with " << signing_key << " ("
+                << masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()) << "), senders checked against the roster "
+                << roster_file << " (" << opt.signed_mode->roster->entries().size() << " senders)" << std::endl;
+    } else if (no_auth) {
       std::cerr << "masa_learner: WARNING: --no-auth: messages are neither signed nor checked; anyone who can "
                    "reach this network can feed this run rollouts\n";
     } else if (lead) {

@@ -1,5 +1,7 @@
 #include "common/transport/message_auth.hpp"
 
+#include "common/transport/message_sign.hpp"
+
 #include <cstring>
 #include <stdexcept>
 
@@ -62,7 +64,11 @@ int MessageAuthenticator::open(std::string_view channel, const void* data, int s
 }
 
 int sizeBeforeTrailer(const void* data, int size) {
-  return data != nullptr && hasMarker(static_cast<const uint8_t*>(data), size) ? size - kAuthTrailerBytes : size;
+  if (data == nullptr) return size;
+  if (hasMarker(static_cast<const uint8_t*>(data), size)) return size - kAuthTrailerBytes;
+  SenderId sender;
+  uint64_t counter = 0;
+  return peekSigner(data, size, sender, counter) ? size - kSigTrailerBytes : size;  // a signed run's SIG1
 }
 
 }  // namespace masa::transport

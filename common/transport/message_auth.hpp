@@ -47,7 +47,8 @@ class MessageAuthenticator {
   evp_mac_ctx_st* keyed_;  // HMAC-SHA256 with the key set: copied for each message
 };
 
-// Without the key: `size` less the trailer when `data` ends in one, else `size`, unverified. For
+// Without the key: `size` less the trailer (MAC1, or a signed run's SIG1, message_sign.hpp) when
+// `data` ends in one, else `size`, unverified. For
 // tools that watch a run's traffic (masa_lcm_probe); never for bytes a process acts on.
 int sizeBeforeTrailer(const void* data, int size);
 

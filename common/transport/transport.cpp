@@ -1,5 +1,9 @@
 #include "common/transport/transport.hpp"
 
+#include "common/transport/channels.hpp"
+#include "masa/lcmt_actor_heartbeat.hpp"
+#include "masa/lcmt_rollout_chunk.hpp"
+
 #include <chrono>
 #include <cstring>
 #include <iostream>
@@ -30,6 +34,20 @@ Transport::Transport(const std::string& url, const std::optional<RunKey>& key) :
   }
 }
 
+SignedMode loadSignedMode(const std::string& roster_path, const std::string& key_path, SenderId id) {
+  SignedMode mode;
+  auto roster = std::make_shared<Roster>(Roster::load(roster_path));
+  mode.signer = MessageSigner::load(key_path, id, *roster);
+  mode.roster = std::move(roster);
+  return mode;
+}
+
+Transport::Transport(const std::string& url, const SignedMode& mode) : Transport(url) {
+  if (!mode.signer || !mode.roster) throw std::invalid_argument("masa transport: signed mode without a signer or roster");
+  signer_ = mode.signer;
+  verifier_ = std::make_unique<MessageVerifier>(mode.roster);
+}
+
 Transport::~Transport() {
   for (Sub& s : subs_) lcm_unsubscribe(lcm_->getUnderlyingLCM(), s.lcm_sub);
 }
@@ -39,7 +57,7 @@ bool Transport::publishWire(const std::string& channel, const void* data, int si
 }
 
 bool Transport::publishRaw(const std::string& channel, const void* data, int size) {
-  if (!auth_) return publishWire(channel, data, size);
+  if (!auth_ && !signer_) return publishWire(channel, data, size);
   std::lock_guard<std::mutex> lock(publish_mutex_);
   uint8_t* buf = publishBuffer(size);
   if (size > 0) std::memcpy(buf, data, static_cast<std::size_t>(size));
@@ -47,20 +65,79 @@ bool Transport::publishRaw(const std::string& channel, const void* data, int siz
 }
 
 uint8_t* Transport::publishBuffer(int size) {
-  const std::size_t needed = static_cast<std::size_t>(size) + (auth_ ? kAuthTrailerBytes : 0);
+  const std::size_t needed =
+      static_cast<std::size_t>(size) + (signer_ ? kSigTrailerBytes : auth_ ? kAuthTrailerBytes : 0);
   if (publish_buf_.size() < needed) publish_buf_.resize(needed);
   return publish_buf_.data();
 }
 
 bool Transport::sendPublishBuffer(const std::string& channel, int size) {
-  if (auth_) {
+  if (signer_) {
+    signer_->seal(channel, publish_buf_.data(), size, publish_buf_.data() + size);
+    size += kSigTrailerBytes;
+  } else if (auth_) {
     auth_->seal(channel, publish_buf_.data(), size, publish_buf_.data() + size);
     size += kAuthTrailerBytes;
   }
   return publishWire(channel, publish_buf_.data(), size);
 }
 
+namespace {
+
+// The channels whose messages name the actor that sends them (lcmt_rollout_chunk and
+// lcmt_actor_heartbeat: int32 actor_id after int64 run_id, at byte 16 after the 8-byte hash).
+struct ActorClaim {
+  const char* channel;
+  int64_t hash;
+};
+const ActorClaim* actorClaimOf(std::string_view channel) {
+  static const ActorClaim kClaims[] = {{kRolloutChannel, masa::lcmt_rollout_chunk::getHash()},
+                                       {kHeartbeatChannel, masa::lcmt_actor_heartbeat::getHash()}};
+  for (const ActorClaim& c : kClaims)
+    if (channel == c.channel) return &c;
+  return nullptr;
+}
+
+int64_t readBigEndian(const uint8_t* p, int bytes) {
+  uint64_t v = 0;
+  for (int i = 0; i < bytes; ++i) v = v << 8 | p[i];
+  return static_cast<int64_t>(v);
+}
+
+// Whether a verified message of `sender` on `channel` claims to be another's: an actor's chunk or
+// heartbeat with another actor id, or one of those from a sender that is not an actor. A message
+// too short or of another type is left to the wire guard, which refuses it.
+bool claimsAnother(std::string_view channel, SenderId sender, const uint8_t* p, int size) {
+  const ActorClaim* claim = actorClaimOf(channel);
+  if (claim == nullptr) return false;
+  if (sender.role != Role::kActor) return true;
+  if (size < 20 || readBigEndian(p, 8) != claim->hash) return false;
+  return readBigEndian(p + 16, 4) != static_cast<int64_t>(static_cast<int32_t>(sender.index));
+}
+
+}  // namespace
+
+OpenedMessage Transport::openSigned(const char* channel, const void* data, int size) {
+  if (last_verdict_.dispatch == dispatch_ && last_verdict_.data == data && last_verdict_.size == size)
+    return last_verdict_.opened;
+  OpenedMessage m = verifier_->open(channel, data, size);
+  if (m.verdict == WireVerdict::kOk && claimsAnother(channel, m.sender, static_cast<const uint8_t*>(data), m.size))
+    m.verdict = WireVerdict::kClaimsAnotherSender;
+  if (m.verdict == WireVerdict::kOk) m.verdict = verifier_->fresh(channel, m);
+  if (m.verdict == WireVerdict::kOk) verifier_->accept(channel, m);
+  last_verdict_ = {dispatch_, data, size, m};
+  return m;
+}
+
 void Transport::deliver(const Sub& sub, const char* channel, const void* data, int size) {
+  if (signer_) {
+    const OpenedMessage m = openSigned(channel, data, size);
+    if (m.verdict != WireVerdict::kOk) return countRejected(channel, m.verdict);
+    current_sender_ = m.sender;
+    sub.handler(data, m.size);
+    current_sender_.reset();
+    return;
+  }
   if (auth_) {
     // The channel it arrived on, as LCM reports it: the tag must be for this one.
     size = auth_->open(channel, data, size);
@@ -136,7 +213,9 @@ void Transport::countRejected(const std::string& channel, WireVerdict why) {
   for (int64_t n : r.count) total += n;
   std::cerr << "masa transport: rejected " << r.unwarned << " message(s) on " << channel << " (latest: "
             << wireVerdictName(why) << "); " << total << " rejected on this channel so far";
-  if (why == WireVerdict::kUnauthenticated)
+  if (why == WireVerdict::kUnauthenticated && signer_)
+    std::cerr << " (unsigned, or a signature that does not verify under the roster's key of the sender it names)";
+  else if (why == WireVerdict::kUnauthenticated)
     std::cerr << " (unsigned, or signed with another key: do all processes of the run share its run.key? our key id "
               << key_id_ << ")";
   std::cerr << "\n";
@@ -145,11 +224,16 @@ void Transport::countRejected(const std::string& channel, WireVerdict why) {
   r.unwarned = 0;
 }
 
-int Transport::handleTimeout(int timeout_ms) { return lcm_->handleTimeout(timeout_ms); }
+int Transport::lcmHandle(int timeout_ms) {
+  ++dispatch_;  // a new message: its subscriptions may share a verdict, nothing before it may
+  return lcm_->handleTimeout(timeout_ms);
+}
+
+int Transport::handleTimeout(int timeout_ms) { return lcmHandle(timeout_ms); }
 
 int Transport::drain() {
   int n = 0;
-  while (lcm_->handleTimeout(0) > 0) ++n;
+  while (lcmHandle(0) > 0) ++n;
   return n;
 }
 

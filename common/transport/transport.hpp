@@ -7,6 +7,11 @@
 // key's trailer, and a received message without a valid one is counted (kUnauthenticated) and
 // never reaches a handler; the others reach it without their trailer, byte for byte as published.
 // Without a key, bytes pass unchanged both ways (in-process memq runs, robot channels, --no-auth).
+// With a signing identity (SignedMode: this process's key and the run's roster, message_sign.hpp),
+// publishing appends a SIG1 trailer (sender, counter, Ed25519 signature), and a received message
+// reaches handlers only when the roster lists its sender, lets it publish on the channel, its
+// signature verifies, an actor's chunk or heartbeat names that actor, and its counter is new;
+// otherwise it is counted under the first reason it fails.
 //
 // Threading: publish() may be called from any thread; handle*() and (un)subscribe() from one
 // thread (handlers run on the thread that calls handle*()).
@@ -26,6 +31,7 @@
 
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/message_auth.hpp"
+#include "common/transport/message_sign.hpp"
 #include "common/transport/run_key.hpp"
 #include "common/transport/wire_guard.hpp"
 
@@ -44,6 +50,18 @@ int64_t wallClockMicros();
 // (about 15% of them in a 2-actor run on this machine); 2048 chunks of 60 KB are about 120 MB.
 inline constexpr int kSubscriptionQueueCapacity = 2048;
 
+// A process's signing identity in a signed run: its signer (shared by the process's transports,
+// so that its counter runs over all of them) and the run's roster.
+struct SignedMode {
+  std::shared_ptr<MessageSigner> signer;
+  std::shared_ptr<const Roster> roster;
+};
+
+// The roster file and this process's private key file (never the key itself on a command line):
+// throws std::runtime_error naming the file when either is refused, or the roster gives `id`
+// another key.
+SignedMode loadSignedMode(const std::string& roster_path, const std::string& key_path, SenderId id);
+
 class Transport {
  public:
   using RawHandler = std::function<void(const void* data, int size)>;
@@ -53,13 +71,18 @@ class Transport {
   // start on the URL. For a udpm URL, warns on stderr when net.core.rmem_max is below the
   // requested recv_buf_size (see recvBufCheck()). With `key`, every message is authenticated.
   explicit Transport(const std::string& url, const std::optional<RunKey>& key = std::nullopt);
+  // Signed: throws std::invalid_argument without a signer or roster.
+  Transport(const std::string& url, const SignedMode& mode);
   ~Transport();
   Transport(const Transport&) = delete;
   Transport& operator=(const Transport&) = delete;
 
   const std::string& url() const { return url_; }
   const RecvBufCheck& recvBufCheck() const { return recv_buf_; }
-  bool authenticates() const { return auth_ != nullptr; }
+  bool authenticates() const { return auth_ != nullptr || signer_ != nullptr; }
+  bool signs() const { return signer_ != nullptr; }
+  // In a handler of a signed transport: the verified sender of the message being handled.
+  const std::optional<SenderId>& currentSender() const { return current_sender_; }
 
   // Encodes into a reused buffer, appends the run key's trailer (with a key) and publishes;
   // returns false when LCM reports a failure. publishRaw does the same for encoded bytes.
@@ -104,6 +127,11 @@ class Transport {
   };
 
   void deliver(const Sub& sub, const char* channel, const void* data, int size);
+  // Signed: every check of message_sign.hpp and the actor-id claim; moves the counter window only
+  // for a message that passes them all. One LCM dispatch hands the same bytes to each subscription
+  // of the channel: the verdict is kept for the others, which must not see a replay.
+  OpenedMessage openSigned(const char* channel, const void* data, int size);
+  int lcmHandle(int timeout_ms);
   void countRejected(const std::string& channel, WireVerdict why);
   // The reused publish buffer, with room for `size` bytes and a trailer; the caller holds publish_mutex_.
   uint8_t* publishBuffer(int size);
@@ -125,6 +153,16 @@ class Transport {
   std::map<std::string, ChannelRejects> rejects_;
   std::unique_ptr<MessageAuthenticator> auth_;  // null: no key
   std::string key_id_;                           // RunKey::id(), for the warnings
+  std::shared_ptr<MessageSigner> signer_;     // null: not signed
+  std::unique_ptr<MessageVerifier> verifier_;  // with signer_
+  std::optional<SenderId> current_sender_;
+  uint64_t dispatch_ = 0;  // LCM dispatches so far (handleTimeout, drain)
+  struct Verdict {
+    uint64_t dispatch = ~uint64_t{0};
+    const void* data = nullptr;
+    int size = 0;
+    OpenedMessage opened;
+  } last_verdict_;
   std::mutex publish_mutex_;
   std::vector<uint8_t> publish_buf_;
 };

@@ -51,6 +51,11 @@ std::string_view wireVerdictName(WireVerdict v) {
     case WireVerdict::kBadString: return "bad_string";
     case WireVerdict::kDecodeFailed: return "decode_failed";
     case WireVerdict::kUnauthenticated: return "unauthenticated";
+    case WireVerdict::kUnknownSender: return "unknown_sender";
+    case WireVerdict::kNotPermitted: return "not_permitted";
+    case WireVerdict::kClaimsAnotherSender: return "claims_another_sender";
+    case WireVerdict::kReplayed: return "replayed";
+    case WireVerdict::kBeyondWindow: return "beyond_window";
     case WireVerdict::kCount: break;
   }
   return "unknown";

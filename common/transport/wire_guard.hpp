@@ -31,7 +31,14 @@ enum class WireVerdict : int {
   kOverLimit,       // an array or string longer than WireLimits allows
   kBadString,       // a string without its terminating NUL, with a NUL inside, or of length 0
   kDecodeFailed,    // the guard passed but lcm-gen's decoder did not consume exactly the bytes
-  kUnauthenticated, // no trailer of the run key that verifies (Transport with a key, message_auth.hpp)
+  kUnauthenticated, // no trailer of the run key that verifies (Transport with a key, message_auth.hpp), or
+                    // no SIG1 trailer whose signature verifies (Transport with a signer, message_sign.hpp)
+  // Signed runs (message_sign.hpp):
+  kUnknownSender,        // the trailer names a sender the run's roster does not list
+  kNotPermitted,         // the roster does not let that sender publish on this channel
+  kClaimsAnotherSender,  // signed by one actor, claiming another's actor id
+  kReplayed,             // its counter was taken before from this sender on this channel
+  kBeyondWindow,         // its counter is more than kReplayWindow below the sender's newest
   kCount
 };
 inline constexpr int kNumWireVerdicts = static_cast<int>(WireVerdict::kCount);

@@ -16,6 +16,11 @@ std::string_view dropReasonName(DropReason r) {
     case DropReason::kOutOfRange: return "out_of_range";
     case DropReason::kWrongTerms: return "wrong_terms";
     case DropReason::kUnauthenticated: return "unauthenticated";
+    case DropReason::kUnknownSender: return "unknown_sender";
+    case DropReason::kNotPermitted: return "not_permitted";
+    case DropReason::kClaimsAnotherActor: return "claims_another_actor";
+    case DropReason::kReplayed: return "replayed";
+    case DropReason::kBeyondWindow: return "beyond_window";
     case DropReason::kLost: return "lost";
     case DropReason::kCount: break;
   }

@@ -23,6 +23,13 @@ enum class DropReason : int {
   // Never a verdict of the assembler: no valid tag of the run key, dropped by the Transport before
   // the assembler sees the bytes (so it moves no actor's state); the learner adds its count.
   kUnauthenticated,
+  // Never verdicts of the assembler either: a signed run's refusals (common/transport/message_sign.hpp),
+  // by the Transport before the assembler sees the bytes.
+  kUnknownSender,        // signed by a sender the roster does not list
+  kNotPermitted,         // by a sender the roster does not let publish rollouts
+  kClaimsAnotherActor,   // signed by one actor, naming another actor id
+  kReplayed,             // a counter this actor used before on this channel
+  kBeyondWindow,         // a counter too far below this actor's newest
   // Never a verdict: chunks that never arrived (UDP loss, a full receive buffer, an actor killed
   // while sending), counted by the assembler from the gaps in each actor's rollout numbering.
   kLost,

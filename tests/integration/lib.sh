@@ -77,7 +77,7 @@ at_least_updates() { [ "$(updates_in "$1")" -ge "$2" ]; }
 set_auth() {
   local a
   for a in "$@"; do
-    [[ "$a" == --key-file || "$a" == --no-auth ]] && { auth=(); return 0; }
+    [[ "$a" == --key-file || "$a" == --no-auth || "$a" == --roster ]] && { auth=(); return 0; }
   done
   bash "$masa_repo/deploy/run_key.sh" "$work/run.key"
   auth=(--key-file "$work/run.key")

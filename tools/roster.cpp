@@ -1,0 +1,93 @@
+// masa_roster: the keys and the roster of a signed run (common/transport/roster.hpp, message_sign.hpp).
+//   masa_roster make RUN_DIR --actors K [--runner]   a key per process, RUN_DIR/keys/<role><index>.key
+//                                                   (mode 0600, directory 0700), and RUN_DIR/roster
+//                                                   with their public keys and the channels of each role
+//   masa_roster show ROSTER                          the senders, their key fingerprints and channels
+// make keeps what is there: a resumed run keeps its keys, and more actors get keys of their own.
+// deploy/train.sh runs it before it starts anything and gives each process its own key file; the
+// private keys stay files, never on a command line.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <sys/stat.h>
+
+#include "common/core/build_info.hpp"
+#include "common/integrity/ed25519_keys.hpp"
+#include "common/transport/roster.hpp"
+
+using namespace masa;
+namespace fs = std::filesystem;
+
+namespace {
+
+void writeRoster(const transport::Roster& roster, const fs::path& path) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << roster.format();
+    if (!out) throw std::runtime_error(tmp.string() + ": cannot write");
+  }
+  ::chmod(tmp.c_str(), 0644);
+  fs::rename(tmp, path);  // appears whole
+}
+
+int make(const std::string& dir, int actors, bool runner) {
+  const fs::path run(dir), keys = run / "keys", roster_path = run / "roster";
+  fs::create_directories(keys);
+  ::chmod(keys.c_str(), 0700);
+  transport::Roster roster;
+  if (fs::exists(roster_path)) roster = transport::Roster::load(roster_path.string());
+  std::vector<transport::SenderId> wanted = {{transport::Role::kLearner, 0}};
+  for (int a = 0; a < actors; ++a) wanted.push_back({transport::Role::kActor, static_cast<uint32_t>(a)});
+  if (runner) wanted.push_back({transport::Role::kRunner, 0});
+  int made = 0;
+  for (const transport::SenderId& id : wanted) {
+    if (roster.find(id)) continue;
+    const std::string stem = (keys / (std::string(transport::roleName(id.role)) + std::to_string(id.index))).string();
+    const integrity::PublicKeyBytes key = integrity::generateKeyPair(stem + ".key", stem + ".pub");
+    roster.add(id, key, transport::defaultChannels(id.role));
+    ++made;
+  }
+  if (made > 0) writeRoster(roster, roster_path);
+  std::printf("masa_roster: %s: %zu senders (%d new keys under %s)\n", roster_path.c_str(), roster.entries().size(), made,
+              keys.c_str());
+  return 0;
+}
+
+int show(const std::string& path) {
+  const transport::Roster roster = transport::Roster::load(path);
+  for (const auto& e : roster.entries()) {
+    std::printf("%-10s %s ", e.id.name().c_str(), integrity::keyFingerprint(e.key).c_str());
+    for (std::size_t i = 0; i < e.channels.size(); ++i) std::printf("%s%s", i ? "," : "", e.channels[i].c_str());
+    std::printf("\n");
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"masa_roster: a key per process and the roster of a signed run"};
+  app.set_version_flag("--version", buildCommit());
+  app.require_subcommand(1);
+  std::string dir, path;
+  int actors = 1;
+  bool runner = false;
+  auto* make_cmd = app.add_subcommand("make", "make the keys and the roster of a run directory (keeps what is there)");
+  make_cmd->add_option("run_dir", dir, "the run directory")->required();
+  make_cmd->add_option("--actors", actors, "actors of the run (keys actor0 .. actorK-1)")->check(CLI::Range(0, 1 << 20));
+  make_cmd->add_flag("--runner", runner, "a key for the robot's policy runner (masa_deploy), on the robot command channel");
+  auto* show_cmd = app.add_subcommand("show", "the senders of a roster");
+  show_cmd->add_option("roster", path, "a roster file")->required();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*make_cmd) return make(dir, actors, runner);
+    return show(path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "masa_roster: %s\n", e.what());
+    return 2;
+  }
+}
