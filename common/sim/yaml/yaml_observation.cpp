@@ -162,93 +162,134 @@ YamlObservation::YamlObservation(const YamlTaskConfig& config, const Task& task,
   }
 }
 
+// The part of resolution every source shares: the entry's size and, for geometric sources, that
+// the entry's kind is how the source transforms under the group.
+struct YamlObservation::Resolving {
+  const ObservationSourceConfig& c;
+  const sym::Entry& e;
+  int limb;  // -1: the central block
+  const Task& task;
+  std::string name;  // the model object this limb's source names ("" when it names none)
+
+  void sizeMustBe(int n, const std::string& what) const {
+    if (n != e.size())
+      throw ConfigError(c.file, c.path,
+                        what + " gives " + std::to_string(n) + " values, but entry '" + e.name + "' of " +
+                            task.spec().source() + " holds " + std::to_string(e.size()) + " (kind " +
+                            sym::entryKindName(e.kind) + (e.count > 1 ? " x " + std::to_string(e.count) : "") + ")");
+  }
+  void geometric(const NaturalAction& natural, int n) const {
+    sizeMustBe(n, describe(c.source, c.body_frame));
+    if (!e.limb_signs.empty() && !signsMatch(e.limb_signs, {}))
+      throw ConfigError(c.file, c.path, "entry '" + e.name + "' has limb_signs, which " +
+                                            describe(c.source, c.body_frame) + " never needs");
+    checkKind(c, e, task.spec(), describe(c.source, c.body_frame) + " ('" + e.name + "')", natural);
+  }
+};
+
 void YamlObservation::resolve(const ObservationSourceConfig& c, const sym::Entry& e, int limb, int out,
                               const Task& task, const std::vector<double>& pose) {
-  const sym::SymmetrySpec& spec = task.spec();
-  const sym::Group& g = spec.group();
-  const MujocoModel& model = task.mujocoModel();
-  const mjModel* m = model.get();
   Item item;
   item.source = c.source;
   item.out = out;
   item.components = c.components;
   item.axis = c.axis;
   item.body_frame = c.body_frame;
-  const std::string name = c.names.empty() ? "" : c.names[std::max(limb, 0)];
-  auto sizeMustBe = [&](int n, const std::string& what) {
-    if (n != e.size())
-      throw ConfigError(c.file, c.path,
-                        what + " gives " + std::to_string(n) + " values, but entry '" + e.name + "' of " + spec.source() +
-                            " holds " + std::to_string(e.size()) + " (kind " + sym::entryKindName(e.kind) +
-                            (e.count > 1 ? " x " + std::to_string(e.count) : "") + ")");
-  };
-  auto geometric = [&](const NaturalAction& natural, int n) {
-    sizeMustBe(n, describe(c.source, c.body_frame));
-    if (!e.limb_signs.empty() && !signsMatch(e.limb_signs, {}))
-      throw ConfigError(c.file, c.path, "entry '" + e.name + "' has limb_signs, which " +
-                                            describe(c.source, c.body_frame) + " never needs");
-    checkKind(c, e, spec, describe(c.source, c.body_frame) + " ('" + e.name + "')", natural);
-  };
-  const int n_comp = static_cast<int>(c.components.size());
-
+  const Resolving r{c, e, limb, task, c.names.empty() ? "" : c.names[std::max(limb, 0)]};
   switch (c.source) {
     case ObsSource::kJointPos:
     case ObsSource::kJointVel:
-    case ObsSource::kLastAction: {
-      const sym::Entry* action = nullptr;
-      int first = 0;
-      if (c.name_key == "action") {
-        action = actionEntry(spec, name, limb, first);
-        if (!action) {
-          std::string known;
-          for (const sym::Entry& a : limb < 0 ? spec.actionLayout().central : spec.actionLayout().limb)
-            known += (known.empty() ? "" : ", ") + a.name;
-          throw ConfigError(c.file, c.path + ".action",
-                            spec.source() + " has no " + (limb < 0 ? "central" : "limb") + " action entry '" + name +
-                                "' (" + (known.empty() ? "none" : known) + ")");
-        }
-        for (int k = 0; k < action->size(); ++k) item.actions.push_back(first + k);
-      } else {
-        const int j = findNamed(model, mjOBJ_JOINT, name, c.file, c.path + ".joint");
-        const auto& joints = task.actionJoints();
-        const auto at = std::find(joints.begin(), joints.end(), j);
-        if (at == joints.end())
-          throw ConfigError(c.file, c.path + ".joint",
-                            "joint '" + name + "' is driven by no action of " + spec.source() +
-                                ", so the symmetry cannot move it; observe actuated joints only");
-        const int a = static_cast<int>(at - joints.begin());
-        int action_limb = 0;
-        action = &entryOfAction(spec, a, action_limb);
-        if (action_limb != limb)
-          throw ConfigError(c.file, c.path + ".joint",
-                            "joint '" + name + "' is driven by an action of " +
-                                (action_limb < 0 ? std::string("the central block") : "limb " + std::to_string(action_limb)) +
-                                ", not of " + (limb < 0 ? std::string("the central block") : "limb " + std::to_string(limb)));
-        item.actions.push_back(a);
-      }
-      sizeMustBe(static_cast<int>(item.actions.size()), "action entry '" + action->name + "'");
-      if (limb >= 0 && !signsMatch(e.limb_signs, action->limb_signs))
-        throw ConfigError(c.file, c.path,
-                          "entry '" + e.name + "' must carry the limb_signs of action '" + action->name + "' in " +
-                              spec.source() + ": its joint changes sign as the action does");
-      if (!action->swap_with.empty() || !e.swap_with.empty())
-        throw ConfigError(c.file, c.path, "entries with swap_with are not supported by YAML tasks yet");
-      sym::Entry one;  // the actions observed: the whole entry, or the one joint named
-      one.kind = action->kind;
-      one.count = static_cast<int>(item.actions.size()) / sym::entryKindSize(action->kind);
-      checkKind(c, e, spec, "the joint of action '" + action->name + "'",
-                [&](int i, std::string&) { return entryAction(one, g, i); }, sym::entryKindName(action->kind));
-      for (int a : item.actions) {
-        const int j = task.actionJoints()[a];
-        if (j < 0 || (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE))
-          throw ConfigError(c.file, c.path, "action " + spec.actNames()[a] + " drives no hinge or slide joint");
-        item.qadr.push_back(m->jnt_qposadr[j]);
-        item.dofadr.push_back(m->jnt_dofadr[j]);
-        // The pose is checked symmetric (yaml_task.cpp), so the offset keeps the joint's kind.
-        item.joint_offset.push_back(c.from_pose ? pose[a] : 0.0);
-      }
-      break;
+    case ObsSource::kLastAction: resolveActuated(r, pose, item); break;
+    case ObsSource::kBodyPos:
+    case ObsSource::kBodyLinVel:
+    case ObsSource::kHeading:
+    case ObsSource::kBodyAngVel:
+    case ObsSource::kBodyQuatW:
+    case ObsSource::kBodyQuatXyz:
+    case ObsSource::kBodyAxis:
+    case ObsSource::kBodyEuler: resolveBody(r, item); break;
+    case ObsSource::kSensor: resolveSensor(r, item); break;
+  }
+  items_.push_back(std::move(item));
+}
+
+// A joint, a joint's velocity or the last action: the joints of an action entry (or one named
+// joint), which must be driven by the same limb's actions and change sign as they do.
+void YamlObservation::resolveActuated(const Resolving& r, const std::vector<double>& pose, Item& item) {
+  const ObservationSourceConfig& c = r.c;
+  const sym::Entry& e = r.e;
+  const int limb = r.limb;
+  const std::string& name = r.name;
+  const Task& task = r.task;
+  const sym::SymmetrySpec& spec = task.spec();
+  const sym::Group& g = spec.group();
+  const MujocoModel& model = task.mujocoModel();
+  const mjModel* m = model.get();
+  const sym::Entry* action = nullptr;
+  int first = 0;
+  if (c.name_key == "action") {
+    action = actionEntry(spec, name, limb, first);
+    if (!action) {
+      std::string known;
+      for (const sym::Entry& a : limb < 0 ? spec.actionLayout().central : spec.actionLayout().limb)
+        known += (known.empty() ? "" : ", ") + a.name;
+      throw ConfigError(c.file, c.path + ".action",
+                        spec.source() + " has no " + (limb < 0 ? "central" : "limb") + " action entry '" + name +
+                            "' (" + (known.empty() ? "none" : known) + ")");
     }
+    for (int k = 0; k < action->size(); ++k) item.actions.push_back(first + k);
+  } else {
+    const int j = findNamed(model, mjOBJ_JOINT, name, c.file, c.path + ".joint");
+    const auto& joints = task.actionJoints();
+    const auto at = std::find(joints.begin(), joints.end(), j);
+    if (at == joints.end())
+      throw ConfigError(c.file, c.path + ".joint",
+                        "joint '" + name + "' is driven by no action of " + spec.source() +
+                            ", so the symmetry cannot move it; observe actuated joints only");
+    const int a = static_cast<int>(at - joints.begin());
+    int action_limb = 0;
+    action = &entryOfAction(spec, a, action_limb);
+    if (action_limb != limb)
+      throw ConfigError(c.file, c.path + ".joint",
+                        "joint '" + name + "' is driven by an action of " +
+                            (action_limb < 0 ? std::string("the central block") : "limb " + std::to_string(action_limb)) +
+                            ", not of " + (limb < 0 ? std::string("the central block") : "limb " + std::to_string(limb)));
+    item.actions.push_back(a);
+  }
+  r.sizeMustBe(static_cast<int>(item.actions.size()), "action entry '" + action->name + "'");
+  if (limb >= 0 && !signsMatch(e.limb_signs, action->limb_signs))
+    throw ConfigError(c.file, c.path,
+                      "entry '" + e.name + "' must carry the limb_signs of action '" + action->name + "' in " +
+                          spec.source() + ": its joint changes sign as the action does");
+  if (!action->swap_with.empty() || !e.swap_with.empty())
+    throw ConfigError(c.file, c.path, "entries with swap_with are not supported by YAML tasks yet");
+  sym::Entry one;  // the actions observed: the whole entry, or the one joint named
+  one.kind = action->kind;
+  one.count = static_cast<int>(item.actions.size()) / sym::entryKindSize(action->kind);
+  checkKind(c, e, spec, "the joint of action '" + action->name + "'",
+            [&](int i, std::string&) { return entryAction(one, g, i); }, sym::entryKindName(action->kind));
+  for (int a : item.actions) {
+    const int j = task.actionJoints()[a];
+    if (j < 0 || (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE))
+      throw ConfigError(c.file, c.path, "action " + spec.actNames()[a] + " drives no hinge or slide joint");
+    item.qadr.push_back(m->jnt_qposadr[j]);
+    item.dofadr.push_back(m->jnt_dofadr[j]);
+    // The pose is checked symmetric (yaml_task.cpp), so the offset keeps the joint's kind.
+    item.joint_offset.push_back(c.from_pose ? pose[a] : 0.0);
+  }
+}
+
+// A body's position, velocities, orientation or axes, or the heading: the components the config
+// picks, each checked to transform as the entry's kind says.
+void YamlObservation::resolveBody(const Resolving& r, Item& item) {
+  const ObservationSourceConfig& c = r.c;
+  const std::string& name = r.name;
+  const sym::SymmetrySpec& spec = r.task.spec();
+  const sym::Group& g = spec.group();
+  const MujocoModel& model = r.task.mujocoModel();
+  const int n_comp = static_cast<int>(c.components.size());
+  auto geometric = [&r](const NaturalAction& natural, int n) { r.geometric(natural, n); };
+  switch (c.source) {
     case ObsSource::kBodyPos:
     case ObsSource::kBodyLinVel:
     case ObsSource::kHeading:
@@ -326,16 +367,21 @@ void YamlObservation::resolve(const ObservationSourceConfig& c, const sym::Entry
           },
           1);
       break;
-    case ObsSource::kSensor: {
-      const int s = findNamed(model, mjOBJ_SENSOR, name, c.file, c.path + ".sensor");
-      item.sensor_adr = m->sensor_adr[s];
-      item.sensor_dim = m->sensor_dim[s];
-      sizeMustBe(item.sensor_dim, "sensor '" + name + "'");
-      uses_sensors_ = true;
+    default:  // the other sources are resolveActuated's and resolveSensor's
       break;
-    }
   }
-  items_.push_back(std::move(item));
+}
+
+// A sensor, taken at the spec's word (the physics verifier checks it).
+void YamlObservation::resolveSensor(const Resolving& r, Item& item) {
+  const ObservationSourceConfig& c = r.c;
+  const std::string& name = r.name;
+  const mjModel* m = r.task.mujocoModel().get();
+  const int s = findNamed(r.task.mujocoModel(), mjOBJ_SENSOR, name, c.file, c.path + ".sensor");
+  item.sensor_adr = m->sensor_adr[s];
+  item.sensor_dim = m->sensor_dim[s];
+  r.sizeMustBe(item.sensor_dim, "sensor '" + name + "'");
+  uses_sensors_ = true;
 }
 
 void YamlObservation::write(const mjData* d, const std::vector<double>& last_action, const Eigen::Vector3d& heading,

@@ -47,8 +47,12 @@ class YamlObservation {
     bool body_frame = false;
   };
 
+  struct Resolving;  // one entry's source being resolved for one limb (yaml_observation.cpp)
   void resolve(const ObservationSourceConfig& c, const sym::Entry& e, int limb, int out, const Task& task,
                const std::vector<double>& pose);
+  void resolveActuated(const Resolving& r, const std::vector<double>& pose, Item& item);
+  void resolveBody(const Resolving& r, Item& item);
+  void resolveSensor(const Resolving& r, Item& item);
 
   std::vector<Item> items_;
   bool uses_sensors_ = false;
