@@ -74,26 +74,35 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   // A run's own config.yaml (resume) replaces the task file as the middle layer: it already holds
   // the task file's values as they were when the run started.
   const bool has_base = base.IsMap();
-  std::string task = has_base && base["task"] ? base["task"].as<std::string>() : schema["task"].as<std::string>();
+  // The task names the file read next, so its errors name the layer that set it (a recipe, the
+  // command line), not the task file that is not there.
+  auto taskName = [](const YAML::Node& n, const std::string& file) {
+    if (!n.IsScalar()) throw ConfigError(file, "task", "expected a task name");
+    return n.as<std::string>();
+  };
+  std::string task_origin = has_base && base["task"] ? base_file : defaults_file;
+  std::string task = taskName(has_base && base["task"] ? base["task"] : schema["task"], task_origin);
   for (const std::string& o : overrides) {
     if (!o.empty() && o[0] == '@') {  // a recipe: a whole YAML overlay, checked like a task file
       const std::string file = resolveRecipe(configs_dir, o.substr(1));
       const YAML::Node node = loadYamlFile(file, "(file)");
-      if (node.IsMap() && node["task"]) task = node["task"].as<std::string>();
+      if (node.IsMap() && node["task"]) task = taskName(node["task"], task_origin = file);
       recipe_files.emplace_back(file, node);
       continue;
     }
     parsed.push_back(parseSetting(o));
-    if (parsed.back().first == "task") task = parsed.back().second.as<std::string>();
+    if (parsed.back().first == "task") task = taskName(parsed.back().second, task_origin = "command line");
   }
 
   const std::string task_file = has_base ? base_file : configs_dir + "/tasks/" + task + ".yaml";
-  if (!has_base && !fs::exists(task_file)) {
+  const bool plain_name = !task.empty() && task.find('/') == std::string::npos && task != "." && task != "..";
+  if (!has_base && (!plain_name || !fs::exists(task_file))) {
     std::string known;
     if (fs::exists(configs_dir + "/tasks"))
       for (const auto& e : fs::directory_iterator(configs_dir + "/tasks"))
         if (e.path().extension() == ".yaml") known += (known.empty() ? "" : ", ") + e.path().stem().string();
-    throw ConfigError(task_file, "task", "unknown task '" + task + "' (known: " + known + ")");
+    throw ConfigError(task_origin, "task",
+                      "unknown task '" + task + "' (no file " + task_file + "; known: " + known + ")");
   }
   layers.overlay(has_base ? base : loadYamlFile(task_file, "task"), task_file);
   for (const auto& [file, node] : recipe_files) layers.overlay(node, file);

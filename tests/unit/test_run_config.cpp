@@ -110,6 +110,22 @@ TEST_F(ScratchConfigs, UnknownKeyInTaskFileNamesTheFileAndTheKey) {
   EXPECT_NE(std::string(e.what()).find("learning_rate"), std::string::npos) << "should list the known keys";
 }
 
+// An unknown task is named where it was written: the recipe or the command line, not the task
+// file that does not exist (found by DamagedText: a damaged recipe's task named only a missing file).
+TEST_F(ScratchConfigs, AnUnknownTaskIsNamedInTheRecipeOrOnTheCommandLineThatSetIt) {
+  writeTask("t", "ppo:\n  horizon: 8\n");
+  const fs::path recipe = dir_ / "r.yaml";
+  std::ofstream(recipe) << "task: no_such\nppo:\n  horizon: 4\n";
+  ConfigError e = expectError({"@" + recipe.string()});
+  EXPECT_EQ(e.file(), recipe.string());
+  EXPECT_EQ(e.key(), "task");
+  EXPECT_NE(std::string(e.what()).find("unknown task 'no_such'"), std::string::npos) << e.what();
+  e = expectError({"task=../t"});
+  EXPECT_EQ(e.file(), "command line");
+  std::ofstream(recipe) << "task: [a, b]\n";
+  EXPECT_EQ(expectError({"@" + recipe.string()}).file(), recipe.string());
+}
+
 TEST_F(ScratchConfigs, UnknownKeyOnCommandLineNamesCommandLine) {
   writeTask("t", "");
   const ConfigError e = expectError({"task=t", "ppo.horizn=3"});
