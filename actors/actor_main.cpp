@@ -123,8 +123,9 @@ int main(int argc, char** argv) {
     }
   }
   if (key_file.empty() && !no_auth && roster_file.empty()) {
-    std::fprintf(stderr, "masa_actor: no run key: give --key-file RUN_DIR/run.key (the learner's), or --no-auth to "
-                         "run without message authentication\n");
+    std::fprintf(stderr, "masa_actor: no key: give --roster RUN_DIR/roster with --signing-key RUN_DIR/keys/actorN.key "
+                         "(a signed run), or --key-file RUN_DIR/run.key (the learner's run key), or --no-auth to run "
+                         "without message authentication\n");
     return 2;
   }
 
