@@ -27,5 +27,26 @@ TEST(OfflineConfigTest, InfinityOrNaNIsRefusedNamingTheKeyPath) {
   }
 }
 
+// Each range by its edge (docs/inputs.md gap 15): the value just outside is refused by key, the
+// edge itself where the range is closed is taken.
+TEST(OfflineConfigTest, EachRangeRefusesTheValueJustOutsideByKey) {
+  const struct {
+    const char* refused;
+    const char* taken;
+  } cases[] = {{"offline.expectile=0", "offline.expectile=0.01"},  {"offline.expectile=1", "offline.expectile=0.99"},
+               {"offline.discount=1.01", "offline.discount=1"},    {"offline.discount=-0.01", "offline.discount=0"},
+               {"offline.polyak=0", "offline.polyak=1"},           {"offline.beta=0", "offline.beta=0.1"},
+               {"offline.steps=0", "offline.steps=1"},             {"offline.batch_size=0", "offline.batch_size=1"},
+               {"offline.log_every=0", "offline.log_every=1"},     {"offline.eval_every=-1", "offline.eval_every=0"},
+               {"offline.q_hidden=[]", "offline.q_hidden=[4]"},    {"offline.algo=cql", "offline.algo=bc"},
+               {"offline.log_std_min=2", "offline.log_std_min=1.9"}};
+  for (const auto& c : cases) {
+    const std::string refused = c.refused;
+    const ConfigError e = test::configErrorOf([&] { readWith({refused}); });
+    EXPECT_EQ(e.key(), refused.substr(0, refused.find('='))) << refused << ": " << e.what();
+    EXPECT_NO_THROW(readWith({c.taken})) << c.taken;
+  }
+}
+
 }  // namespace
 }  // namespace masa::offline

@@ -126,6 +126,26 @@ TEST_F(ScratchConfigs, AnUnknownTaskIsNamedInTheRecipeOrOnTheCommandLineThatSetI
   EXPECT_EQ(expectError({"@" + recipe.string()}).file(), recipe.string());
 }
 
+// A recipe is checked like a task file (docs/inputs.md gap 15): an unknown key, a map where a
+// number belongs and a value out of range are each refused naming the recipe and the key.
+TEST_F(ScratchConfigs, ABadRecipeIsRefusedNamingTheRecipeAndTheKey) {
+  writeTask("t", "ppo:\n  horizon: 8\n");
+  const fs::path recipe = dir_ / "bad_recipe.yaml";
+  const struct {
+    const char* text;
+    const char* key;
+  } cases[] = {{"task: t\nppo:\n  horizn: 4\n", "ppo.horizn"},
+               {"task: t\nppo:\n  horizon: {a: 1}\n", "ppo.horizon"},
+               {"task: t\nppo:\n  horizon: 0\n", "ppo.horizon"},
+               {"task: t\nppo:\n  learning_rate: .nan\n", "ppo.learning_rate"}};
+  for (const auto& c : cases) {
+    std::ofstream(recipe) << c.text;
+    const ConfigError e = expectError({"@" + recipe.string()});
+    EXPECT_EQ(e.file(), recipe.string()) << c.text;
+    EXPECT_EQ(e.key(), c.key) << c.text << ": " << e.what();
+  }
+}
+
 TEST_F(ScratchConfigs, UnknownKeyOnCommandLineNamesCommandLine) {
   writeTask("t", "");
   const ConfigError e = expectError({"task=t", "ppo.horizn=3"});
