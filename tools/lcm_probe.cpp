@@ -8,8 +8,9 @@
 // The latency includes what the publisher does after stamping utime (encoding, sending every
 // fragment), the network, LCM's reassembly and the probe's own scheduling: under load, it is what
 // a subscriber that polls without delay would see.
-// With --key-file (a run's run.key) only messages with a valid tag count, the others are reported
-// as unauthenticated; without it, a message's tag is skipped unchecked (the probe only watches).
+// With --key-file (a run's run.key) only messages with a valid tag count, with --roster (a signed
+// run's roster) only messages whose signature, sender, channel and counter verify; the others are
+// reported by reason. Without either, a message's trailer is skipped unchecked (the probe only watches).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -20,6 +21,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,6 +30,7 @@
 #include "common/transport/channels.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/message_auth.hpp"
+#include "common/transport/roster.hpp"
 #include "common/transport/run_key.hpp"
 #include "common/transport/transport.hpp"
 #include "common/transport/wire_guard.hpp"
@@ -103,8 +106,13 @@ int main(int argc, char** argv) {
   app.add_option("--run-id", run_id, "count only messages of this run (0: any run)");
   app.add_option("--csv", csv_path, "write one row per message: channel,recv_us,utime,latency_us,bytes,version");
   app.add_flag("--quiet", quiet, "print the summary only, not one line per message");
-  std::string key_file;
-  app.add_option("--key-file", key_file, "the run's run.key: count only messages with a valid tag (default: tags unchecked)");
+  std::string key_file, roster_file;
+  auto* key_opt =
+      app.add_option("--key-file", key_file, "the run's run.key: count only messages with a valid tag (default: tags unchecked)");
+  app.add_option("--roster", roster_file,
+                 "a signed run's RUN_DIR/roster: count only messages whose signature, sender, channel and counter "
+                 "verify (no key needed)")
+      ->excludes(key_opt);
   CLI11_PARSE(app, argc, argv);
   if (all)
     channels = {transport::kPolicyChannel, transport::kLearnerStatsChannel, transport::kHeartbeatChannel,
@@ -126,13 +134,19 @@ int main(int argc, char** argv) {
   try {
     std::optional<transport::RunKey> key;
     if (!key_file.empty()) key = transport::readRunKey(key_file);
-    transport::Transport bus(url, key);
+    const bool checked = key || !roster_file.empty();
+    std::unique_ptr<transport::Transport> owned =
+        roster_file.empty() ? std::make_unique<transport::Transport>(url, key)
+                            : std::make_unique<transport::Transport>(
+                                  url, transport::SignedMode{nullptr, std::make_shared<const transport::Roster>(
+                                                                          transport::Roster::load(roster_file))});
+    transport::Transport& bus = *owned;
     if (!bus.recvBufCheck().sufficient) std::fprintf(stderr, "masa_lcm_probe: %s\n", bus.recvBufCheck().message.c_str());
     for (const std::string& ch : channels) {
       logs[ch];
       bus.subscribeRaw(ch, [&, ch](const void* data, int size) {
         const int64_t now = transport::wallClockMicros();  // first: decoding is not the network's time
-        if (!key) size = transport::sizeBeforeTrailer(data, size);
+        if (!checked) size = transport::sizeBeforeTrailer(data, size);
         const auto stamp = readStamp(ch, data, size);
         if (stamp && run_id != 0 && stamp->run_id != run_id) return;
         ChannelLog& log = logs[ch];
@@ -161,7 +175,9 @@ int main(int argc, char** argv) {
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     std::fprintf(stderr, "masa_lcm_probe: listening on %s; %s\n", url.c_str(),
-                 key ? ("tags checked with run key id " + key->id()).c_str() : "tags not checked (no --key-file)");
+                 key ? ("tags checked with run key id " + key->id()).c_str()
+                 : !roster_file.empty() ? ("signatures checked against the roster " + roster_file).c_str()
+                                        : "tags not checked (no --key-file or --roster)");
     const auto start = std::chrono::steady_clock::now();
     while (!g_stop.load()) {
       if (bus.handleTimeout(100) < 0) {
@@ -174,8 +190,13 @@ int main(int argc, char** argv) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= duration_s)
         break;
     }
-    for (auto& [ch, log] : logs)
-      log.unauthenticated = bus.rejected(ch)[static_cast<int>(transport::WireVerdict::kUnauthenticated)];
+    for (auto& [ch, log] : logs) {
+      if (roster_file.empty()) {
+        log.unauthenticated = bus.rejected(ch)[static_cast<int>(transport::WireVerdict::kUnauthenticated)];
+      } else {  // every reason a signed run refuses for: signature, sender, channel, claim, counter
+        for (int64_t n : bus.rejected(ch)) log.unauthenticated += n;
+      }
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_lcm_probe: %s\n", e.what());
     return 2;
@@ -208,8 +229,9 @@ int main(int argc, char** argv) {
       std::printf("  %s: %lld messages did not decode as the channel's type\n", ch.c_str(),
                   static_cast<long long>(log.undecoded));
     if (log.unauthenticated > 0)
-      std::printf("  %s: %lld messages without a valid tag of the run key, not counted above\n", ch.c_str(),
-                  static_cast<long long>(log.unauthenticated));
+      std::printf(roster_file.empty() ? "  %s: %lld messages without a valid tag of the run key, not counted above\n"
+                                      : "  %s: %lld messages refused by the roster's checks, not counted above\n",
+                  ch.c_str(), static_cast<long long>(log.unauthenticated));
   }
   return 0;
 }

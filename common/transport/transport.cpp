@@ -43,8 +43,8 @@ SignedMode loadSignedMode(const std::string& roster_path, const std::string& key
 }
 
 Transport::Transport(const std::string& url, const SignedMode& mode) : Transport(url) {
-  if (!mode.signer || !mode.roster) throw std::invalid_argument("masa transport: signed mode without a signer or roster");
-  signer_ = mode.signer;
+  if (!mode.roster) throw std::invalid_argument("masa transport: signed mode without a roster");
+  signer_ = mode.signer;  // null: a watcher that verifies and never publishes (masa_lcm_probe --roster)
   verifier_ = std::make_unique<MessageVerifier>(mode.roster);
 }
 
@@ -57,6 +57,7 @@ bool Transport::publishWire(const std::string& channel, const void* data, int si
 }
 
 bool Transport::publishRaw(const std::string& channel, const void* data, int size) {
+  if (verifier_ && !signer_) throw std::logic_error("masa transport: a watcher (roster, no signing key) cannot publish");
   if (!auth_ && !signer_) return publishWire(channel, data, size);
   std::lock_guard<std::mutex> lock(publish_mutex_);
   uint8_t* buf = publishBuffer(size);
@@ -72,6 +73,7 @@ uint8_t* Transport::publishBuffer(int size) {
 }
 
 bool Transport::sendPublishBuffer(const std::string& channel, int size) {
+  if (verifier_ && !signer_) throw std::logic_error("masa transport: a watcher (roster, no signing key) cannot publish");
   if (signer_) {
     signer_->seal(channel, publish_buf_.data(), size, publish_buf_.data() + size);
     size += kSigTrailerBytes;
@@ -130,7 +132,7 @@ OpenedMessage Transport::openSigned(const char* channel, const void* data, int s
 }
 
 void Transport::deliver(const Sub& sub, const char* channel, const void* data, int size) {
-  if (signer_) {
+  if (verifier_) {
     const OpenedMessage m = openSigned(channel, data, size);
     if (m.verdict != WireVerdict::kOk) return countRejected(channel, m.verdict);
     current_sender_ = m.sender;
@@ -213,7 +215,7 @@ void Transport::countRejected(const std::string& channel, WireVerdict why) {
   for (int64_t n : r.count) total += n;
   std::cerr << "masa transport: rejected " << r.unwarned << " message(s) on " << channel << " (latest: "
             << wireVerdictName(why) << "); " << total << " rejected on this channel so far";
-  if (why == WireVerdict::kUnauthenticated && signer_)
+  if (why == WireVerdict::kUnauthenticated && verifier_)
     std::cerr << " (unsigned, or a signature that does not verify under the roster's key of the sender it names)";
   else if (why == WireVerdict::kUnauthenticated)
     std::cerr << " (unsigned, or signed with another key: do all processes of the run share its run.key? our key id "

@@ -71,7 +71,8 @@ class Transport {
   // start on the URL. For a udpm URL, warns on stderr when net.core.rmem_max is below the
   // requested recv_buf_size (see recvBufCheck()). With `key`, every message is authenticated.
   explicit Transport(const std::string& url, const std::optional<RunKey>& key = std::nullopt);
-  // Signed: throws std::invalid_argument without a signer or roster.
+  // Signed: throws std::invalid_argument without a roster. Without a signer it only watches: every
+  // message is verified against the roster, and publishing throws std::logic_error.
   Transport(const std::string& url, const SignedMode& mode);
   ~Transport();
   Transport(const Transport&) = delete;
@@ -79,7 +80,7 @@ class Transport {
 
   const std::string& url() const { return url_; }
   const RecvBufCheck& recvBufCheck() const { return recv_buf_; }
-  bool authenticates() const { return auth_ != nullptr || signer_ != nullptr; }
+  bool authenticates() const { return auth_ != nullptr || verifier_ != nullptr; }
   bool signs() const { return signer_ != nullptr; }
   // In a handler of a signed transport: the verified sender of the message being handled.
   const std::optional<SenderId>& currentSender() const { return current_sender_; }
@@ -154,7 +155,7 @@ class Transport {
   std::unique_ptr<MessageAuthenticator> auth_;  // null: no key
   std::string key_id_;                           // RunKey::id(), for the warnings
   std::shared_ptr<MessageSigner> signer_;     // null: not signed
-  std::unique_ptr<MessageVerifier> verifier_;  // with signer_
+  std::unique_ptr<MessageVerifier> verifier_;  // signed runs (with signer_, or alone for a watcher)
   std::optional<SenderId> current_sender_;
   uint64_t dispatch_ = 0;  // LCM dispatches so far (handleTimeout, drain)
   struct Verdict {

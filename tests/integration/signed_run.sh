@@ -36,6 +36,11 @@ bash deploy/run_key.sh "$work/other.key"
 start_actor 3 "$url" "$run_id" --key-file "$work/other.key" --start-without-learner
 hmac=$actor_pid
 wait_until 90 "the learner's first update" at_least_updates "$run" 1
+# A watcher with the roster and no key (masa_lcm_probe --roster) counts the run's own chunks and
+# refuses the intruders' by reason.
+"$build/tools/masa_lcm_probe" --url "$url" --channel MASA_ROLLOUT --roster "$run/roster" --duration 3 --quiet \
+  > "$work/probe.log" 2>&1 &
+probe=$!
 
 # What is on the command lines of the run's processes: paths, never a key.
 args=$(ps -eo args | grep -E "masa_(learner|actor)" | grep -F "$run" | grep -v grep || true)
@@ -50,6 +55,10 @@ done
   fail "the roster does not list the learner and actors 0 and 1: $(cat "$run/roster")"
 
 wait "$train_pid" || fail "train.sh did not finish cleanly"
+wait "$probe" || fail "masa_lcm_probe --roster failed: $(tail -n 3 "$work/probe.log")"
+awk '$1 == "MASA_ROLLOUT" && $2 > 0 { found = 1 } END { exit !found }' "$work/probe.log" ||
+  fail "the watcher verified no chunk of the run: $(cat "$work/probe.log")"
+grep -q "rejected .* on MASA_ROLLOUT" "$work/probe.log" || fail "the watcher refused no intruder's chunk: $(cat "$work/probe.log")"
 kill -TERM "$intruder" "$hmac"
 wait "$intruder" "$hmac" || fail "an intruding actor did not stop cleanly on SIGTERM"
 
@@ -67,5 +76,5 @@ unauth=$(sed -n 's/.*unauthenticated \([0-9][0-9]*\).*/\1/p' <<< "$line")
 [ -n "$unknown" ] && [ "$unknown" -gt 0 ] || fail "no chunk counted unknown_sender: $line"
 [ "$unknown" -le "$sent" ] || fail "$unknown chunks counted unknown_sender, more than the $sent actor 2 sent"
 [ -n "$unauth" ] && [ "$unauth" -gt 0 ] || fail "no chunk of the run-key actor counted unauthenticated: $line"
-echo "PASS: $(updates_in "$run") signed updates from actors 0 and 1; the learner refused $unknown chunks of an unlisted actor 2 (unknown_sender) and $unauth of a run-key actor (unauthenticated); keys mode 0600, only paths on command lines"
+echo "PASS: $(updates_in "$run") signed updates from actors 0 and 1 (a watcher with the roster verified them too); the learner refused $unknown chunks of an unlisted actor 2 (unknown_sender) and $unauth of a run-key actor (unauthenticated); keys mode 0600, only paths on command lines"
 rm -rf "$work"

@@ -242,6 +242,29 @@ TEST(MessageSignTransport, ASignedMessageReachesEverySubscriptionOnceWithItsOrig
   EXPECT_FALSE(bus.currentSender().has_value()) << "only inside a handler";
 }
 
+// A watcher (masa_lcm_probe --roster) holds the roster and no key: it verifies as a member does and
+// cannot publish, neither signed nor unsigned.
+TEST(MessageSignTransport, AWatcherWithTheRosterVerifiesEveryMessageAndCannotPublish) {
+  SignedRun run(1, "watcher");
+  Transport bus("memq://", SignedMode{nullptr, run.roster});
+  EXPECT_TRUE(bus.authenticates());
+  EXPECT_FALSE(bus.signs());
+  int taken = 0;
+  bus.subscribeRaw(kPolicyChannel, [&](const void*, int) { ++taken; });
+  const std::vector<uint8_t> message = encode(samplePolicy());
+  const int n = static_cast<int>(message.size()) + kSigTrailerBytes;
+  ASSERT_TRUE(bus.publishWire(kPolicyChannel, signedBytes(*run.learner, kPolicyChannel, message).data(), n));
+  ASSERT_TRUE(bus.publishWire(kPolicyChannel, signedBytes(*run.actors[0], kPolicyChannel, message).data(), n));
+  ASSERT_TRUE(bus.publishWire(kPolicyChannel, message.data(), static_cast<int>(message.size())));
+  for (int i = 0; i < 5; ++i) bus.handleTimeout(10);
+  EXPECT_EQ(taken, 1) << "only the learner's parameters: " << bus.rejectSummary();
+  EXPECT_EQ(count(bus, kPolicyChannel, WireVerdict::kNotPermitted), 1);
+  EXPECT_EQ(count(bus, kPolicyChannel, WireVerdict::kUnauthenticated), 1);
+  EXPECT_THROW(bus.publishRaw(kPolicyChannel, message.data(), static_cast<int>(message.size())), std::logic_error);
+  EXPECT_THROW(bus.publish(kPolicyChannel, samplePolicy()), std::logic_error);
+  EXPECT_THROW(Transport("memq://", SignedMode{run.learner, nullptr}), std::invalid_argument);
+}
+
 TEST(MessageSignTransport, AReplayedValidMessageIsRefusedAndCountedAndOneFromBeyondTheWindowToo) {
   SignedRun run(1, "replay");
   Transport bus("memq://", run.as(run.actors[0]));
