@@ -20,6 +20,7 @@ seconds=${1:-20}
 load=${2:-}
 src=$(cd "$(dirname "$0")/.." && pwd)
 build=${MASA_BUILD_DIR:-$src/build}
+bash "$src/bench/build_benchmarks.sh" "$build"
 core=${MASA_BENCH_CORE:-1}
 source_core=${MASA_BENCH_SOURCE_CORE:-0}
 variants=${MASA_BENCH_VARIANTS:-before warm busy after}

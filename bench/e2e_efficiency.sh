@@ -25,7 +25,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 build=${MASA_BUILD_DIR:-build}
-[ -x "$build/bench/bench_efficiency_bound" ] || { echo "e2e_efficiency.sh: build first (scripts/build.sh)" >&2; exit 2; }
+bash "$(dirname "$0")/build_benchmarks.sh" "$build"
 resolved=$("$build/tools/masa_config" --set "@$recipe")
 envs=$(sed -n 's/^  num_envs: //p' <<< "$resolved")
 mb=$(sed -n 's/^  minibatch_size: //p' <<< "$resolved")

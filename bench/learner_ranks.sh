@@ -17,7 +17,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 bin=${MASA_BUILD_DIR:-build}/bench/bench_learner_ranks
-[ -x "$bin" ] || { echo "learner_ranks.sh: $bin is missing: build first" >&2; exit 2; }
+bash "$(dirname "$0")/build_benchmarks.sh" "${MASA_BUILD_DIR:-build}"
 {
   echo "# $(date -u +%FT%TZ) $(git rev-parse --short HEAD) on $(bash experiments/machine.sh 2> /dev/null || hostname)"
   echo "# bench/learner_ranks.sh $recipe --cores $cores --updates $updates"

@@ -27,7 +27,7 @@ ours=$build/bench/bench_learner_step
 torch=$build/bench/libtorch/bench_learner_step_libtorch
 libdir=/usr/lib/x86_64-linux-gnu
 
-[ -x "$ours" ] || { echo "missing $ours: build the benchmarks first" >&2; exit 1; }
+bash "$root/bench/build_benchmarks.sh" "$build"
 [ -x "$torch" ] || {
   echo "missing $torch: run scripts/install_bench_deps.sh, then reconfigure and build" >&2
   exit 1

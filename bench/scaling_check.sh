@@ -22,6 +22,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 build=${MASA_BUILD_DIR:-build}
+bash "$(dirname "$0")/build_benchmarks.sh" "$build"
 mkdir -p "$out"
 machine=$(bash experiments/machine.sh 2> /dev/null || hostname)
 echo "# $(date -u +%FT%TZ) $(git rev-parse --short HEAD 2> /dev/null || echo '?') on $machine, $cores cores, load $(cut -d' ' -f1-3 /proc/loadavg)" | tee "$out/check.txt"
