@@ -81,14 +81,20 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
 
   model_ = std::make_unique<model::ActorCritic<float>>(spec, config_.model);
   policy_param_count_ = model_->policyParamCount();
+  int model_param_count = static_cast<int>(model_->params().size());
+  if (config_.learner == "off_policy") {
+    squashed_ = std::make_unique<SquashedBehaviour>(config_, spec);
+    policy_param_count_ = model_param_count = squashed_->paramCount();  // the learner sends the policy only
+  }
   params_check_ = std::make_unique<ParamsCheck>(ParamsExpectation{
       .run_id = options_.run_id, .task = config_.task, .method = model::methodName(config_.method),
-      .policy_param_count = policy_param_count_, .model_param_count = static_cast<int>(model_->params().size()),
+      .policy_param_count = policy_param_count_, .model_param_count = model_param_count,
       .obs_dim = obs_dim_, .max_version_step = options_.max_version_step});
   {
     // Own initial parameters: used only with start_without_learner, and deterministic per seed.
     Rng init_rng = envRng(config_.seed, options_.actor_id, -1);
     model_->initialize(init_rng);
+    if (squashed_) squashed_->initialize(init_rng);
   }
   if (options_.start_without_learner) version_ = 0;
 
@@ -100,7 +106,7 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
   ep_success_.assign(num_envs_, -1);
   ep_terms_.assign(static_cast<std::size_t>(num_envs_) * std::max(num_terms_, 1), 0.0f);
   log_std_.resize(act_dim_);
-  pending_params_.resize(model_->params().size());
+  pending_params_.resize(std::max<std::size_t>(model_->params().size(), model_param_count));
   pending_mean_.resize(obs_dim_);
   pending_std_.resize(obs_dim_);
 
@@ -182,9 +188,14 @@ void Actor::rejectParams(int64_t version, const std::string& why) {
 
 void Actor::swapInPending() {
   if (pending_version_ < 0) return;
-  auto& values = model_->params().values();
-  std::copy(pending_params_.begin(), pending_params_.begin() + pending_count_, values.data());
-  if (pending_has_norm_) model_->obsNormalizer().setMeanStd(pending_mean_.data(), pending_std_.data());
+  if (squashed_) {
+    squashed_->set(pending_params_.data(), pending_has_norm_ ? pending_mean_.data() : nullptr,
+                   pending_has_norm_ ? pending_std_.data() : nullptr);
+  } else {
+    auto& values = model_->params().values();
+    std::copy(pending_params_.begin(), pending_params_.begin() + pending_count_, values.data());
+    if (pending_has_norm_) model_->obsNormalizer().setMeanStd(pending_mean_.data(), pending_std_.data());
+  }
   version_ = pending_version_;
   pending_version_ = -1;
 }
@@ -247,7 +258,8 @@ bool Actor::collectAndPublish() {
   const int64_t acting_version = version_;
   const int E = num_envs_;
   rollout_.clearEvents();
-  model_->logStd(log_std_);
+  if (squashed_) log_std_.setZero();  // SAC's std depends on the state; the field is PPO's
+  else model_->logStd(log_std_);
   rollout_.setLogStd(log_std_.data());
 
   for (int e = 0; e < E; ++e) envs_[e]->observe(rollout_.obsAt(0, e));
@@ -255,22 +267,29 @@ bool Actor::collectAndPublish() {
   for (int t = 0; t < horizon_; ++t) {
     // Step t's observations, actions and means are contiguous obs_dim x E / act_dim x E blocks.
     Eigen::Map<const Mat<float>> obs(rollout_.obsAt(t, 0), obs_dim_, E);
+    float* log_prob = rollout_.log_prob.data() + rollout_.step(t, 0);
     singleThreaded([&] {
+      if (squashed_) {  // the whole block's actions at once, each environment's noise its own
+        squashed_->act(obs, rngs_, Eigen::Map<Mat<float>>(rollout_.actionAt(t, 0), act_dim_, E),
+                       Eigen::Map<Mat<float>>(rollout_.meanAt(t, 0), act_dim_, E), log_prob);
+        return;
+      }
       auto mean = model_->actMean(obs);
       Eigen::Map<Mat<float>>(rollout_.meanAt(t, 0), act_dim_, E) = mean;
     });
-    float* log_prob = rollout_.log_prob.data() + rollout_.step(t, 0);
     float* reward = rollout_.reward.data() + rollout_.step(t, 0);
     uint8_t* term = rollout_.terminated.data() + rollout_.step(t, 0);
     uint8_t* trunc = rollout_.truncated.data() + rollout_.step(t, 0);
 
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int e = 0; e < E; ++e) {
-      Eigen::Map<const Mat<float>> mu(rollout_.meanAt(t, e), act_dim_, 1);
-      Eigen::Map<Mat<float>> act(rollout_.actionAt(t, e), act_dim_, 1);
-      Eigen::Map<Mat<float>> lp(log_prob + e, 1, 1);
-      model::gaussian::sample<float>(mu, log_std_, rngs_[e], act);
-      model::gaussian::logProb<float>(mu, log_std_, act, lp);
+      if (!squashed_) {
+        Eigen::Map<const Mat<float>> mu(rollout_.meanAt(t, e), act_dim_, 1);
+        Eigen::Map<Mat<float>> act(rollout_.actionAt(t, e), act_dim_, 1);
+        Eigen::Map<Mat<float>> lp(log_prob + e, 1, 1);
+        model::gaussian::sample<float>(mu, log_std_, rngs_[e], act);
+        model::gaussian::logProb<float>(mu, log_std_, act, lp);
+      }
       auto& env = *envs_[e];
       const task::StepOutcome out = env.step(rollout_.actionAt(t, e));
       reward[e] = static_cast<float>(out.reward);

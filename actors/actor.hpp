@@ -1,5 +1,7 @@
 // An actor process's worker: E task instances stepped together, acting with the newest policy
-// received from the learner, and streaming each T-step rollout as LCM chunks.
+// received from the learner, and streaming each T-step rollout as LCM chunks. The policy is PPO's
+// Gaussian, or with learner: off_policy the SAC policy (squashed_behaviour.hpp); the rollouts are
+// the same either way.
 //
 // Determinism: environment e of actor a draws resets and action noise from its own Rng, seeded
 // from (run seed, a, e), so a run is reproducible for any thread count. Parameters received while
@@ -27,6 +29,7 @@
 #include "actors/policy_lag_window.hpp"
 #include "common/rollout/rollout.hpp"
 #include "actors/rollout_chunker.hpp"
+#include "actors/squashed_behaviour.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
@@ -158,6 +161,8 @@ class Actor {
   std::vector<std::unique_ptr<task::Task>> envs_;
   std::vector<Rng> rngs_;
   std::unique_ptr<model::ActorCritic<float>> model_;
+  // learner: off_policy: the actions come from the SAC policy instead (model_ only sizes nothing).
+  std::unique_ptr<SquashedBehaviour> squashed_;
   int policy_param_count_ = 0;  // the policy + log-std prefix of the flat parameters
   std::unique_ptr<ParamsCheck> params_check_;  // made once the model's sizes are known
   rollout::Rollout rollout_;

@@ -12,7 +12,9 @@
 #include <stdexcept>
 
 #include "common/cluster/rank_agreement.hpp"
+#include "common/core/binary_io.hpp"
 #include "common/core/check.hpp"
+#include "common/integrity/sealed_file.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/sim/policy_evaluator.hpp"
 #include "learner/checkpoint.hpp"
@@ -87,8 +89,13 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   nn::AdamConfig<float> adam_cfg;
   adam_cfg.lr = static_cast<float>(rc_.ppo.learning_rate);
   adam_ = std::make_unique<nn::Adam<float>>(model_->params(), adam_cfg);
+  if (rc_.learner == "off_policy") {
+    MASA_CHECK(opt_.make_off_policy, "learner: off_policy is not built into this program (masa_learner and masa_train run it)");
+    MASA_CHECK(ranks_->size() == 1, "learner: off_policy runs on one learner rank (" << ranks_->size() << " given)");
+    off_policy_ = opt_.make_off_policy(rc_, rng_);
+  }
   const int64_t batch_samples = static_cast<int64_t>(rc_.ppo.num_envs) * rc_.ppo.horizon;
-  MASA_CHECK(batch_samples % rc_.ppo.minibatch_size == 0,
+  MASA_CHECK(off_policy_ || batch_samples % rc_.ppo.minibatch_size == 0,
              "ppo.minibatch_size " << rc_.ppo.minibatch_size << " must divide the batch, ppo.num_envs x ppo.horizon = "
                                    << batch_samples);
   trainer_ = std::make_unique<ppo::PpoTrainer>(*model_, *adam_, rc_.ppo, *ranks_);
@@ -143,7 +150,8 @@ void Learner::evaluate() {
   o.seed = 1000000;
   o.deterministic = true;
   o.threads = omp_get_max_threads();
-  task::PolicyEvaluator evaluator(*eval_factory_, *model_);
+  const auto off_policy_model = off_policy_ ? off_policy_->evaluationModel() : nullptr;
+  task::PolicyEvaluator evaluator(*eval_factory_, off_policy_model ? *off_policy_model : *model_);
   const task::EvalSummary s = evaluator.run(o);
   report_.eval_return = s.ret.mean;
   report_.eval_length = s.length.mean;
@@ -232,10 +240,10 @@ bool Learner::step(int timeout_ms) {
   }
   bool updated = false;
   if (!waiting_for_ranks_) {
-    bool batch = collector_ && collector_->take(*buffer_);
+    bool batch = collector_ && collector_->take(*buffer_, &origin_);
     // The missing environments were lost: waiting would not bring them.
     if (!batch && collector_ && round_.settled(std::chrono::steady_clock::now()))
-      batch = collector_->takeShort(*buffer_, min_batch_envs_);
+      batch = collector_->takeShort(*buffer_, min_batch_envs_, &origin_);
     const bool stopping = stop_ && stop_->load();
     // A rank whose actors died (or cannot reach its URL) would never bring a batch, and the others
     // would wait for it in the barrier for ever: after runner.rank_silence_stop_s it stops them all.
@@ -299,7 +307,7 @@ void Learner::run(int64_t max_updates, const std::atomic<bool>* stop) {
 
 bool Learner::renderLearningCurve() { return curve_ && curve_->renderAndWait(); }
 
-void Learner::update() {
+void Learner::optimizePpo() {
   trainer_->prepare(*buffer_);
   if (!restored_order_.empty()) {
     // A resumed run continues the shuffle of the run it resumes (see PpoTrainer::shuffleOrder).
@@ -307,6 +315,19 @@ void Learner::update() {
     restored_order_.clear();
   }
   report_.ppo = trainer_->optimize(*buffer_, rng_);
+}
+
+void Learner::update() {
+  // How far behind the parameters being trained the batch's environments acted, in updates.
+  double lag_mean = 0;
+  int64_t lag_max = 0;
+  for (int64_t v : origin_.env_version) {
+    lag_mean += static_cast<double>(updates_ - v) / static_cast<double>(origin_.env_version.size());
+    lag_max = std::max(lag_max, updates_ - v);
+  }
+  if (off_policy_) report_.ppo = off_policy_->learn(buffer_->data(), rng_);
+  else optimizePpo();
+
 
   const auto now = std::chrono::steady_clock::now();
   const double dt = std::chrono::duration<double>(now - last_update_).count();
@@ -340,6 +361,7 @@ void Learner::update() {
   if (!isLeadRank()) return;  // rank 0 speaks for the ranks and keeps the run directory
   publishParams();
   report();
+  if (off_policy_) appendOffPolicyRow(lag_mean, lag_max);
   if (rc_.runner.checkpoint_every > 0 && updates_ % rc_.runner.checkpoint_every == 0) writeCheckpoint();
   if (rc_.runner.snapshot_every > 0 && updates_ % rc_.runner.snapshot_every == 0) writeSnapshot();
 }
@@ -376,7 +398,8 @@ void Learner::writeSnapshot() {
   fs::create_directories(dir);
   char name[32];
   std::snprintf(name, sizeof name, "policy_u%06lld.bin", static_cast<long long>(updates_));
-  policy::savePolicyFile((dir / name).string(), rc_, *model_);
+  if (off_policy_) off_policy_->savePolicyFile((dir / name).string());
+  else policy::savePolicyFile((dir / name).string(), rc_, *model_);
 }
 
 void Learner::publishParams() {
@@ -386,6 +409,17 @@ void Learner::publishParams() {
   m.version = updates_;
   m.method = model::methodName(rc_.method);
   m.task = rc_.task;
+  if (off_policy_) {
+    off_policy_->fillPolicyMessage(m);
+  } else {
+    fillPpoParams(m);
+  }
+  publisher().publish(transport::kPolicyChannel, m);
+  last_publish_ = std::chrono::steady_clock::now();
+  delivery_.published(m.version, last_publish_);
+}
+
+void Learner::fillPpoParams(masa::lcmt_policy_params& m) const {
   // The policy prefix only: the critic is the learner's business, and it halves the broadcast.
   const auto& p = model_->params().values();
   m.num_params = model_->policyParamCount();
@@ -402,9 +436,6 @@ void Learner::publishParams() {
   } else {
     m.obs_dim = 0;
   }
-  publisher().publish(transport::kPolicyChannel, m);
-  last_publish_ = std::chrono::steady_clock::now();
-  delivery_.published(m.version, last_publish_);
 }
 
 void Learner::writeCheckpoint() {
@@ -420,9 +451,12 @@ void Learner::writeCheckpoint() {
   rng_text << rng_;
   s.rng_state = rng_text.str();
   s.order = trainer_->shuffleOrder();
+  // The off-policy state first: checkpoint.bin, written last, says which update both are of.
+  if (off_policy_) writeOffPolicyState();
   learner::writeCheckpoint((fs::path(dir_) / "checkpoint.bin").string(), s, *model_, *adam_);
   // What inference needs, for evaluation and deployment (masa_eval, the robot runner).
-  policy::savePolicyFile((fs::path(dir_) / "policy.bin").string(), rc_, *model_);
+  if (off_policy_) off_policy_->savePolicyFile((fs::path(dir_) / "policy.bin").string());
+  else policy::savePolicyFile((fs::path(dir_) / "policy.bin").string(), rc_, *model_);
   if (checkpoint_hook_) checkpoint_hook_(updates_);
 }
 
@@ -456,6 +490,46 @@ void Learner::loadCheckpoint() {
   if (isLeadRank()) truncateMetricsCsv((fs::path(dir_) / "metrics.csv").string(), s.updates);  // rows past the checkpoint come again
   trainer_->learningRate().setLr(s.lr);
   adam_->config().lr = static_cast<float>(s.lr);
+  if (off_policy_) readOffPolicyState();
+}
+
+namespace {
+const integrity::FileKind kOffPolicyStateKind{"masa off-policy learner state", "MASAOFF1"};
+}
+
+void Learner::writeOffPolicyState() {
+  std::ostringstream os;
+  io::writePod(os, updates_);
+  off_policy_->save(os);
+  integrity::writeSealedFile((fs::path(dir_) / "off_policy_state.bin").string(), kOffPolicyStateKind, os.str());
+}
+
+void Learner::appendOffPolicyRow(double lag_mean, int64_t lag_max) {
+  const fs::path path = fs::path(dir_) / "off_policy.csv";
+  const bool fresh = !fs::exists(path) || fs::file_size(path) == 0;
+  std::ofstream f(path, std::ios::app);
+  const auto figures = off_policy_->roundFigures();
+  if (fresh) {
+    f << "update,env_steps,policy_lag_mean,policy_lag_max";
+    for (const auto& [name, value] : figures) f << ',' << name;
+    f << '\n';
+  }
+  f.precision(9);
+  f << updates_ << ',' << env_steps_ << ',' << lag_mean << ',' << lag_max;
+  for (const auto& [name, value] : figures) f << ',' << value;
+  f << '\n';
+}
+
+void Learner::readOffPolicyState() {
+  const std::string path = (fs::path(dir_) / "off_policy_state.bin").string();
+  std::istringstream is(integrity::readSealedFile(path, kOffPolicyStateKind).payload);
+  int64_t updates = -1;
+  if (!io::readPod(is, updates)) throw std::runtime_error(path + ": truncated");
+  if (updates != updates_)
+    throw std::runtime_error("resume: " + path + " is of update " + std::to_string(updates) + ", checkpoint.bin of " +
+                             std::to_string(updates_) + " (stopped while writing them?)");
+  off_policy_->load(is, path);
+  truncateMetricsCsv((fs::path(dir_) / "off_policy.csv").string(), updates_);  // rows past the checkpoint come again
 }
 
 }  // namespace masa::learner

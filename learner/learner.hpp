@@ -31,6 +31,7 @@
 #include "learner/intake/rollout_assembler.hpp"
 #include "learner/intake/round_tracker.hpp"
 #include "learner/learning_curve.hpp"
+#include "learner/off_policy_learning.hpp"
 #include "learner/params_delivery.hpp"
 #include "learner/update_report.hpp"
 #include "learner/ppo/ppo_trainer.hpp"
@@ -60,6 +61,10 @@ struct LearnerOptions {
   cluster::Communicator* ranks = nullptr;
   std::string rollout_url;  // "" = url
   int rank_check_every = 10;
+  // Makes the algorithm of a run whose `learner` is off_policy (off_policy_learning.hpp), from the
+  // run config and the learner's seeded generator; masa_learner and masa_train pass
+  // learner/sac's. Unset: such a run is refused.
+  std::function<std::unique_ptr<OffPolicyLearning>(const config::RunConfig&, Rng&)> make_off_policy;
 };
 
 class Learner {
@@ -124,6 +129,14 @@ class Learner {
   // of the parameters comes due sooner.
   int waitMs(int timeout_ms) const;
   void update();
+  void optimizePpo();  // PPO's passes over the batch in buffer_
+  void fillPpoParams(masa::lcmt_policy_params& m) const;
+  // learner: off_policy's state beside checkpoint.bin (off_policy_state.bin, sealed).
+  void writeOffPolicyState();
+  void readOffPolicyState();
+  // A row of off_policy.csv: the update, env steps, the policy lag of the batch (in updates: mean,
+  // max) and the algorithm's figures of the round.
+  void appendOffPolicyRow(double lag_mean, int64_t lag_max);
   // Every rank's parameters, normalizers and learning rate hash the same, or RankDisagreement.
   void checkRanksAgree();
   // Tells the update: the stats message, metrics.csv, the curve, the progress line.
@@ -142,6 +155,8 @@ class Learner {
   std::unique_ptr<nn::Adam<float>> adam_;
   std::unique_ptr<ppo::PpoTrainer> trainer_;
   std::unique_ptr<ppo::RolloutBuffer> buffer_;
+  std::unique_ptr<OffPolicyLearning> off_policy_;  // learner: off_policy (then PPO's trainer idles)
+  BatchOrigin origin_;  // where the batch's environments came from: their policy versions (the lag)
 
   cluster::Communicator* ranks_;
   int rank_envs_;  // this rank's environments of a full batch

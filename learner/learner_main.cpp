@@ -27,6 +27,7 @@
 #include "common/transport/run_key.hpp"
 #include "learner/intake/drop_reason.hpp"
 #include "learner/learner.hpp"
+#include "learner/sac/off_policy_rule.hpp"
 
 namespace {
 
@@ -105,6 +106,7 @@ int main(int argc, char** argv) {
     opt.run_id = run_id;
     opt.ranks = ranks;
     opt.rank_check_every = rank_check_every;
+    opt.make_off_policy = masa::sac::makeOffPolicyRule;
     opt.verbose = lead;
     if (ranks) opt.rollout_url = masa::transport::rankRolloutUrl(url, ranks->rank(), ranks->size());
     if (!resume_dir.empty()) {

@@ -22,6 +22,7 @@
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
 #include "learner/learner.hpp"
+#include "learner/sac/off_policy_rule.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -70,6 +71,7 @@ int main(int argc, char** argv) {
     lo.run_id = 1;
     lo.verbose = !quiet;
     lo.resume = !resume.empty();
+    lo.make_off_policy = masa::sac::makeOffPolicyRule;
     masa::learner::Learner learner(rc, lo);
     learner.setMaxUpdates(updates);
 

@@ -112,6 +112,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
 
   const ConfigSection r = layers.section();
   rc.task = r.get<std::string>("task", "a task name");
+  rc.learner = r.oneOf("learner", {"ppo", "off_policy"});
   try {
     rc.method = model::parseMethod(r.get<std::string>("method", "a method name"));
   } catch (const std::invalid_argument& e) {

@@ -68,6 +68,8 @@ struct RunConfig {
   std::string task;
   model::Method method = model::Method::kMasa;
   std::uint64_t seed = 0;
+  // ppo | off_policy: what masa_learner runs on the actors' rollouts (docs/off_policy.md).
+  std::string learner = "ppo";
   std::string spec_path;  // resolved: absolute or relative to the configs dir's parent
   model::ModelConfig model;
   PpoConfig ppo;

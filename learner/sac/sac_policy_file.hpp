@@ -17,8 +17,8 @@
 
 #include "common/config/run_config.hpp"
 #include "common/model/actor_critic.hpp"
-#include "learner/sac/sac_config.hpp"
-#include "learner/sac/sac_policy.hpp"
+#include "common/config/sac_config.hpp"
+#include "common/model/sac_policy.hpp"
 
 namespace masa::sac {
 

@@ -13,8 +13,7 @@
 #include "common/sim/registry.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_policy_file.hpp"
-#include "learner/sac/sac_trainer.hpp"
-#include "learner/sac/td3_trainer.hpp"
+#include "learner/sac/trainer_factory.hpp"
 #include "tasks/tasks.hpp"
 
 namespace masa::sac {
@@ -32,23 +31,6 @@ std::string duration(double s) {
   return b;
 }
 
-std::unique_ptr<OffPolicyTrainer<float>> makeTrainer(const SacConfig& sc, const sym::SymmetrySpec& spec,
-                                                     SacPolicy<float>& policy, offline::TwinQ<float>& q,
-                                                     offline::TwinQ<float>& q_target) {
-  if (sc.algorithm == "td3") return std::make_unique<Td3Trainer<float>>(spec, policy, q, q_target, sc);
-  return std::make_unique<SacTrainer<float>>(policy, q, q_target, sc);
-}
-
-SacPolicyShape policyShape(const config::RunConfig& rc, const SacConfig& sc) {
-  SacPolicyShape s;
-  s.method = rc.method;
-  s.hidden = sc.policy_hidden;
-  s.activation = rc.model.activation;
-  s.log_std_min = sc.log_std_min;
-  s.log_std_max = sc.log_std_max;
-  s.sasa_coef = rc.model.sasa_policy_coef;
-  return s;
-}
 }  // namespace
 
 struct SacRun::Impl {
@@ -208,7 +190,7 @@ SacRunResult SacRun::run() {
   const SacConfig& sc = m.sc;
   const int od = m.spec.obsDim(), ad = m.spec.actDim();
   if (m.opt.verbose)
-    std::printf("%s %s / %s seed %llu: %lld env steps, %lld random first, %d update(s) per step of batch %d, n-step %d "
+    std::printf("%s %s / %s seed %llu: %lld env steps, %lld random first, %g update(s) per step of batch %d, n-step %d "
                 "-> %s\n",
                 m.rc.task.c_str(), sc.algorithm == "td3" ? "TD3" : "SAC", model::methodName(m.rc.method).c_str(),
                 static_cast<unsigned long long>(m.rc.seed),
@@ -246,7 +228,8 @@ SacRunResult SacRun::run() {
     m.t_done = t;
     if (t == sc.learning_starts) m.fitNormalizer();
     if (t >= sc.learning_starts) {
-      for (int u = 0; u < sc.updates_per_step; ++u) {
+      // The steps this many transitions are owed (the schedule has no state of its own to resume).
+      for (long long owed = gradientStepsOwed(sc, t - sc.learning_starts + 1); m.trainer->steps() < owed;) {
         m.replay.sample(sc.batch_size, sc.n_step, sc.discount, m.rng, batch);
         const SacStats s = m.trainer->step(batch, m.rng);
         sums.q_loss += s.q_loss;

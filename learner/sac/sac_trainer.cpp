@@ -8,7 +8,7 @@
 #include "common/core/binary_io.hpp"
 #include "common/nn/serialize.hpp"
 #include "learner/sac/sac_losses.hpp"
-#include "learner/sac/squashed_gaussian.hpp"
+#include "common/model/squashed_gaussian.hpp"
 
 namespace masa::sac {
 namespace {

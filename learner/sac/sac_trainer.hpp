@@ -18,8 +18,8 @@
 #include "learner/offline/twin_q.hpp"
 #include "learner/sac/off_policy_trainer.hpp"
 #include "learner/sac/replay_buffer.hpp"
-#include "learner/sac/sac_config.hpp"
-#include "learner/sac/sac_policy.hpp"
+#include "common/config/sac_config.hpp"
+#include "common/model/sac_policy.hpp"
 
 namespace masa::sac {
 

@@ -8,8 +8,8 @@
 #include "common/core/binary_io.hpp"
 #include "common/nn/serialize.hpp"
 #include "learner/sac/sac_losses.hpp"
-#include "learner/sac/squashed_gaussian.hpp"
-#include "learner/sac/td3_noise.hpp"
+#include "common/model/squashed_gaussian.hpp"
+#include "common/model/td3_noise.hpp"
 
 namespace masa::sac {
 namespace {

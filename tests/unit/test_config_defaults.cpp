@@ -7,7 +7,7 @@
 
 #include "deploy/runner/deploy_config.hpp"
 #include "learner/offline/offline_config.hpp"
-#include "learner/sac/sac_config.hpp"
+#include "common/config/sac_config.hpp"
 
 namespace masa {
 namespace {

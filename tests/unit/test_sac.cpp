@@ -15,7 +15,7 @@
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_losses.hpp"
 #include "learner/sac/sac_trainer.hpp"
-#include "learner/sac/squashed_gaussian.hpp"
+#include "common/model/squashed_gaussian.hpp"
 #include "model_test_support.hpp"
 
 namespace masa::sac {

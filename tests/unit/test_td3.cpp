@@ -16,8 +16,8 @@
 #include "common/core/config_error.hpp"
 #include "learner/sac/replay_buffer.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
-#include "learner/sac/squashed_gaussian.hpp"
-#include "learner/sac/td3_noise.hpp"
+#include "common/model/squashed_gaussian.hpp"
+#include "common/model/td3_noise.hpp"
 #include "learner/sac/td3_trainer.hpp"
 #include "model_test_support.hpp"
 

@@ -1,4 +1,4 @@
-#include "learner/sac/squashed_gaussian.hpp"
+#include "common/model/squashed_gaussian.hpp"
 
 #include <cmath>
 #include <numbers>

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/config/run_config.hpp"
+#include "common/model/sac_policy.hpp"
 
 namespace masa::sac {
 
@@ -15,7 +16,7 @@ struct SacConfig {
   long long buffer_size = 1000000;
   int batch_size = 256;
   long long learning_starts = 5000;
-  int updates_per_step = 1;
+  double updates_per_step = 1;  // may be fractional: gradient steps owed = floor(ratio x steps past learning_starts)
   int n_step = 1;
   double discount = 0.99;
   double polyak = 0.005;
@@ -39,5 +40,13 @@ struct SacConfig {
 // Reads rc.resolved["sac"] (config::sectionOf); throws masa::ConfigError naming the key path
 // (sac.polyak) and the file that set it. Every number must be finite.
 SacConfig readSacConfig(const config::RunConfig& rc);
+
+// The SAC policy's shape of a run: the sac section's widths and bounds, the model section's
+// activation and SASA weight (masa_sac's learner and the off-policy actors build the same policy).
+SacPolicyShape policyShape(const config::RunConfig& rc, const SacConfig& sc);
+
+// Gradient steps owed once `steps_past_start` transitions arrived since learning started:
+// floor(updates_per_step x steps_past_start) (0 before). A fractional ratio spreads them evenly.
+long long gradientStepsOwed(const SacConfig& sc, long long steps_past_start);
 
 }  // namespace masa::sac

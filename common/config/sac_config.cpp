@@ -1,5 +1,6 @@
-#include "learner/sac/sac_config.hpp"
+#include "common/config/sac_config.hpp"
 
+#include <cmath>
 #include <string>
 
 namespace masa::sac {
@@ -12,7 +13,7 @@ SacConfig readSacConfig(const config::RunConfig& rc) {
   c.buffer_size = r.atLeast("buffer_size", 1LL);
   c.batch_size = r.atLeast("batch_size", 1);
   c.learning_starts = r.atLeast("learning_starts", 1LL);
-  c.updates_per_step = r.atLeast("updates_per_step", 1);
+  c.updates_per_step = r.positive("updates_per_step");
   c.n_step = r.atLeast("n_step", 1);
   c.discount = r.inRange("discount", 0.0, 1.0);
   c.polyak = r.inRange("polyak", 0.0, 1.0, true);
@@ -39,6 +40,23 @@ SacConfig readSacConfig(const config::RunConfig& rc) {
   c.td3_noise_clip = r.nonNegative("td3_noise_clip");
   c.td3_policy_delay = r.atLeast("td3_policy_delay", 1);
   return c;
+}
+
+SacPolicyShape policyShape(const config::RunConfig& rc, const SacConfig& sc) {
+  SacPolicyShape s;
+  s.method = rc.method;
+  s.hidden = sc.policy_hidden;
+  s.activation = rc.model.activation;
+  s.log_std_min = sc.log_std_min;
+  s.log_std_max = sc.log_std_max;
+  s.sasa_coef = rc.model.sasa_policy_coef;
+  return s;
+}
+
+long long gradientStepsOwed(const SacConfig& sc, long long steps_past_start) {
+  if (steps_past_start <= 0) return 0;
+  // + 1e-9: a ratio like 0.1 times 10 steps is one step, not 0.9999999.
+  return static_cast<long long>(std::floor(sc.updates_per_step * static_cast<double>(steps_past_start) + 1e-9));
 }
 
 }  // namespace masa::sac

@@ -1,4 +1,4 @@
-#include "learner/sac/sac_policy.hpp"
+#include "common/model/sac_policy.hpp"
 
 #include <cmath>
 #include <istream>
@@ -7,7 +7,7 @@
 
 #include "common/core/binary_io.hpp"
 #include "common/nn/serialize.hpp"
-#include "learner/sac/squashed_gaussian.hpp"
+#include "common/model/squashed_gaussian.hpp"
 
 namespace masa::sac {
 namespace {

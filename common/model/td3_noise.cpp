@@ -1,4 +1,4 @@
-#include "learner/sac/td3_noise.hpp"
+#include "common/model/td3_noise.hpp"
 
 #include "common/core/check.hpp"
 

@@ -1,0 +1,195 @@
+#include "learner/sac/off_policy_rule.hpp"
+
+#include <cmath>
+#include <istream>
+#include <ostream>
+#include <stdexcept>
+
+#include "common/core/binary_io.hpp"
+#include "common/model/method.hpp"
+#include "learner/sac/sac_critic_maps.hpp"
+#include "learner/sac/sac_policy_file.hpp"
+#include "learner/sac/trainer_factory.hpp"
+
+namespace masa::sac {
+namespace {
+constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'O', 'F', 'F', '1'};
+}
+
+OffPolicyRule::OffPolicyRule(const config::RunConfig& rc, Rng& rng)
+    : rc_(rc),
+      sc_(readSacConfig(rc)),
+      spec_(sym::SymmetrySpec::load(rc.spec_path)),
+      policy_(spec_, policyShape(rc, sc_)),
+      q_(spec_, twinQMaps(rc.method, spec_), sc_.q_hidden, rc.model.activation),
+      q_target_(spec_, twinQMaps(rc.method, spec_), sc_.q_hidden, rc.model.activation),
+      replay_(spec_.obsDim(), spec_.actDim(), sc_.buffer_size) {
+  policy_.initialize(rng, static_cast<float>(rc.model.policy_last_layer_scale));
+  q_.initialize(rng);
+  q_target_.moveTowards(q_, 1.0f);
+  trainer_ = makeTrainer(sc_, spec_, policy_, q_, q_target_);
+}
+
+OffPolicyRule::~OffPolicyRule() = default;
+
+std::unique_ptr<learner::OffPolicyLearning> makeOffPolicyRule(const config::RunConfig& rc, Rng& rng) {
+  return std::make_unique<OffPolicyRule>(rc, rng);
+}
+
+ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, Rng& rng) {
+  const int E = b.num_envs, T = b.horizon;
+  // Where each truncated step's pre-reset observation is (the list is in step order).
+  std::vector<int> final_of(static_cast<std::size_t>(E) * T, -1);
+  for (int i = 0; i < b.numFinal(); ++i) final_of[static_cast<std::size_t>(b.final_index[i])] = i;
+  for (int e = 0; e < E; ++e) {
+    for (int t = 0; t < T; ++t) {
+      const std::size_t s = b.step(t, e);
+      const bool truncated = b.truncated[s] != 0;
+      if (truncated && final_of[s] < 0) throw std::logic_error("off-policy learner: a truncation without its observation");
+      const float* next = truncated ? b.finalObs(final_of[s]) : b.obsAt(t + 1, e);
+      // The stretch's last step is cut: what follows it is in the next round's batch, if anywhere.
+      replay_.add(b.obsAt(t, e), b.actionAt(t, e), b.reward[s], next, b.terminated[s] != 0, truncated || t == T - 1);
+    }
+  }
+  received_ += static_cast<long long>(E) * T;
+  if (!fitted_ && received_ >= sc_.learning_starts) fitNormalizer();
+
+  ppo::PpoStats out;
+  round_means_ = SacStats{};
+  round_steps_ = 0;
+  if (!fitted_) return out;
+  SacStats sums;
+  int n = 0;
+  for (const long long owed = gradientStepsOwed(sc_, received_ - sc_.learning_starts + 1); trainer_->steps() < owed; ++n) {
+    replay_.sample(sc_.batch_size, sc_.n_step, sc_.discount, rng, batch_);
+    const SacStats s = trainer_->step(batch_, rng);
+    sums.q_loss += s.q_loss;
+    sums.actor_loss += s.actor_loss;
+    sums.alpha_loss += s.alpha_loss;
+    sums.symmetry_loss += s.symmetry_loss;
+    sums.alpha += s.alpha;
+    sums.mean_q += s.mean_q;
+    sums.entropy += s.entropy;
+  }
+  round_steps_ = n;
+  if (n == 0) return out;
+  for (double* v : {&sums.q_loss, &sums.actor_loss, &sums.alpha_loss, &sums.symmetry_loss, &sums.alpha, &sums.mean_q,
+                    &sums.entropy})
+    *v /= n;
+  round_means_ = sums;
+  out.actor_loss = sums.actor_loss;
+  out.critic_loss = sums.q_loss;
+  out.entropy = sums.entropy;
+  out.sym_policy_loss = sums.symmetry_loss;
+  out.mean_value = sums.mean_q;
+  out.minibatches = n;
+  return out;
+}
+
+std::vector<std::pair<std::string, double>> OffPolicyRule::roundFigures() const {
+  const SacStats& m = round_means_;
+  const double none = std::nan("");  // a round without gradient steps (the warm-up) has no losses
+  auto mean = [&](double v) { return round_steps_ > 0 ? v : none; };
+  return {{"gradient_steps", round_steps_},
+          {"gradient_steps_total", static_cast<double>(trainer_->steps())},
+          {"replay_size", static_cast<double>(replay_.size())},
+          {"warming_up", fitted_ ? 0.0 : 1.0},
+          {"q_loss", mean(m.q_loss)},
+          {"actor_loss", mean(m.actor_loss)},
+          {"alpha_loss", mean(m.alpha_loss)},
+          {"symmetry_loss", mean(m.symmetry_loss)},
+          {"alpha", mean(m.alpha)},
+          {"mean_q", mean(m.mean_q)},
+          {"entropy", mean(m.entropy)}};
+}
+
+void OffPolicyRule::fitNormalizer() {
+  const int d = spec_.obsDim();
+  std::vector<float> mean(d, 0.0f), std(d, 1.0f);  // the identity when observations are not normalized
+  if (rc_.model.normalize_obs) {
+    auto& norm = policy_.obsNormalizer();
+    Mat<float> chunk;
+    constexpr long long kChunk = 4096;
+    for (long long at = 0; at < replay_.size(); at += kChunk) {
+      const long long len = std::min(kChunk, replay_.size() - at);
+      chunk.resize(d, len);
+      for (long long j = 0; j < len; ++j) chunk.col(j) = Eigen::Map<const Eigen::VectorXf>(replay_.obsAt(at + j), d);
+      norm.update(chunk);
+    }
+    for (int k = 0; k < d; ++k) {
+      mean[k] = static_cast<float>(norm.mean()(k));
+      std[k] = static_cast<float>(std::sqrt(norm.var()(k) + 1e-5));
+    }
+  }
+  norm_mean_ = std::move(mean);
+  norm_std_ = std::move(std);
+  applyNormalizer();
+  fitted_ = true;
+}
+
+void OffPolicyRule::applyNormalizer() {
+  // Exactly the floats the actors are sent, so that learner and actors normalize alike.
+  policy_.obsNormalizer().setMeanStd(norm_mean_.data(), norm_std_.data());
+  policy_.setNormalizes(true);
+}
+
+void OffPolicyRule::fillPolicyMessage(masa::lcmt_policy_params& m) const {
+  const auto& p = policy_.params().values();
+  m.num_params = static_cast<int32_t>(p.size());
+  m.params.assign(p.data(), p.data() + p.size());
+  if (!fitted_) {  // warming up: the actors act uniformly at random
+    m.obs_dim = 0;
+    m.obs_mean.clear();
+    m.obs_std.clear();
+    return;
+  }
+  m.obs_dim = static_cast<int32_t>(norm_mean_.size());
+  m.obs_mean = norm_mean_;
+  m.obs_std = norm_std_;
+}
+
+std::unique_ptr<model::ActorCritic<float>> OffPolicyRule::evaluationModel() const {
+  return toActorCritic(policy_, spec_, policyFileConfig(rc_, sc_, policy_.normalizes()).model);
+}
+
+void OffPolicyRule::savePolicyFile(const std::string& path) const { saveSacPolicyFile(path, rc_, sc_, policy_, spec_); }
+
+void OffPolicyRule::save(std::ostream& os) const {
+  os.write(kMagic, sizeof kMagic);
+  io::writePod(os, received_);
+  const int32_t fitted = fitted_ ? 1 : 0;
+  io::writePod(os, fitted);
+  if (fitted_) {
+    os.write(reinterpret_cast<const char*>(norm_mean_.data()), static_cast<std::streamsize>(sizeof(float) * norm_mean_.size()));
+    os.write(reinterpret_cast<const char*>(norm_std_.data()), static_cast<std::streamsize>(sizeof(float) * norm_std_.size()));
+  }
+  trainer_->save(os);  // the policy with its normalizer, Q, Q', the optimizers
+  replay_.save(os);
+}
+
+void OffPolicyRule::load(std::istream& is, const std::string& source_name) {
+  char magic[8] = {};
+  is.read(magic, sizeof magic);
+  if (!is || std::string(magic, 8) != std::string(kMagic, 8))
+    throw std::runtime_error(source_name + ": not an off-policy learner state");
+  int32_t fitted = 0;
+  if (!io::readPod(is, received_) || !io::readPod(is, fitted) || received_ < 0 || (fitted != 0 && fitted != 1))
+    throw std::runtime_error(source_name + ": corrupt off-policy learner state");
+  fitted_ = fitted == 1;
+  if (fitted_) {
+    const std::size_t d = static_cast<std::size_t>(spec_.obsDim());
+    norm_mean_.resize(d);
+    norm_std_.resize(d);
+    is.read(reinterpret_cast<char*>(norm_mean_.data()), static_cast<std::streamsize>(sizeof(float) * d));
+    is.read(reinterpret_cast<char*>(norm_std_.data()), static_cast<std::streamsize>(sizeof(float) * d));
+    if (!is) throw std::runtime_error(source_name + ": truncated off-policy learner state");
+    for (std::size_t k = 0; k < d; ++k)
+      if (!std::isfinite(norm_mean_[k]) || !(norm_std_[k] > 0.0f) || !std::isfinite(norm_std_[k]))
+        throw std::runtime_error(source_name + ": bad normalizer entry " + std::to_string(k));
+  }
+  trainer_->load(is);
+  replay_.load(is);
+  if (fitted_) applyNormalizer();
+}
+
+}  // namespace masa::sac

@@ -1,0 +1,73 @@
+// SAC or TD3 (sac.algorithm) as the Learner's off-policy update (learner/off_policy_learning.hpp):
+// the distributed form of masa_sac, fed by actors over LCM.
+//
+// Each round's batch (E environments x T steps, step-major) goes into the replay buffer
+// environment by environment, in time order, so that every stored stretch is one environment's
+// consecutive steps: the next observation is the next step's (a time-out's own pre-reset
+// observation at a truncation), and the stretch's last step is stored as cut, which is what a
+// time-out is to an n-step return: stop there and bootstrap from that step's next observation.
+// A stretch never runs on into another environment's steps.
+//
+// Warm-up: until sac.learning_starts transitions arrived the actors act uniformly at random (the
+// parameters go out without a normalizer); then the normalizer is fitted on them and fixed, as in
+// masa_sac, and the gradient steps start: floor(updates_per_step x transitions past the start).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "common/config/run_config.hpp"
+#include "common/config/sac_config.hpp"
+#include "common/model/sac_policy.hpp"
+#include "learner/off_policy_learning.hpp"
+#include "learner/offline/twin_q.hpp"
+#include "learner/sac/off_policy_trainer.hpp"
+#include "learner/sac/replay_buffer.hpp"
+
+namespace masa::sac {
+
+class OffPolicyRule final : public learner::OffPolicyLearning {
+ public:
+  // Initializes the networks from rng (the learner's generator, seeded by the run).
+  OffPolicyRule(const config::RunConfig& rc, Rng& rng);
+  ~OffPolicyRule() override;
+
+  ppo::PpoStats learn(const rollout::Rollout& batch, Rng& rng) override;
+  void fillPolicyMessage(masa::lcmt_policy_params& m) const override;
+  std::unique_ptr<model::ActorCritic<float>> evaluationModel() const override;
+  void savePolicyFile(const std::string& path) const override;
+  void save(std::ostream& os) const override;
+  void load(std::istream& is, const std::string& source_name) override;
+  std::vector<std::pair<std::string, double>> roundFigures() const override;
+  long long gradientSteps() const override { return trainer_->steps(); }
+  long long replaySize() const override { return replay_.size(); }
+
+  long long transitionsReceived() const { return received_; }
+  bool warmingUp() const { return !fitted_; }
+  const ReplayBuffer& replay() const { return replay_; }
+  SacPolicy<float>& policy() { return policy_; }
+
+ private:
+  void fitNormalizer();
+  void applyNormalizer();
+
+  config::RunConfig rc_;
+  SacConfig sc_;
+  sym::SymmetrySpec spec_;
+  SacPolicy<float> policy_;
+  offline::TwinQ<float> q_, q_target_;
+  std::unique_ptr<OffPolicyTrainer<float>> trainer_;
+  ReplayBuffer replay_;
+  long long received_ = 0;  // transitions taken into replay since the run began
+  bool fitted_ = false;     // the normalizer is fitted: learning has started
+  // The fitted normalizer as the actors are sent it (kept: a reloaded normalizer would re-derive it).
+  std::vector<float> norm_mean_, norm_std_;
+  ReplayBatch<float> batch_;
+  SacStats round_means_;  // of the last learn()'s gradient steps
+  int round_steps_ = 0;
+};
+
+// For LearnerOptions::make_off_policy.
+std::unique_ptr<learner::OffPolicyLearning> makeOffPolicyRule(const config::RunConfig& rc, Rng& rng);
+
+}  // namespace masa::sac

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# learner: off_policy resumed from its checkpoint (masa_train, stopped at --updates) goes on as the
+# run never stopped: metrics.csv and off_policy.csv, round by round, are the uninterrupted run's
+# (clocks aside). The replay buffer, the networks, their optimizers, the fitted normalizer and the
+# generator all travel in off_policy_state.bin; the stop falls after the warm-up, so all of them matter.
+#   tests/integration/off_policy_resume_exact.sh BUILD_DIR WORK_DIR
+set -euo pipefail
+build=$(cd "$1" && pwd) work=$2
+rm -rf "$work" && mkdir -p "$work" && cd "$work"
+fail() { echo "FAIL: $*"; for f in *.log; do echo "--- $f"; tail -n 5 "$f"; done; exit 1; }
+export OMP_NUM_THREADS=1
+train=("$build/tools/masa_train" --quiet --threads 1)
+tiny=(--set task=a1_beam --set learner=off_policy --set ppo.num_envs=8 --set ppo.horizon=16 --set env.max_episode_steps=40
+      --set sac.learning_starts=200 --set sac.updates_per_step=0.25 --set sac.batch_size=16 --set "sac.policy_hidden=[16]"
+      --set "sac.q_hidden=[16]" --set sac.n_step=2 --set runner.checkpoint_every=3 --set runner.eval_every=4
+      --set runner.eval_episodes=1 --set runner.plot_every=0)
+strip() { awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) skip[c] = ($c == "wall_time_s" || $c == "fps") }
+                   { line = ""; for (c = 1; c <= NF; c++) if (!skip[c]) line = line $c ","; print line }' "$1"; }
+"${train[@]}" --updates 12 --run-dir whole "${tiny[@]}" > whole.log 2>&1 || fail "the whole run failed"
+"${train[@]}" --updates 5 --run-dir parts "${tiny[@]}" > parts1.log 2>&1 || fail "the first part failed"
+[ -s parts/off_policy_state.bin ] || fail "no off_policy_state.bin beside the checkpoint"
+"${train[@]}" --updates 12 --resume parts > parts2.log 2>&1 || fail "the resume failed: $(tail -n 2 parts2.log)"
+cmp -s <(strip whole/metrics.csv) <(strip parts/metrics.csv) || fail "metrics.csv differs: $(diff <(strip whole/metrics.csv) <(strip parts/metrics.csv) | head -4)"
+cmp -s whole/off_policy.csv parts/off_policy.csv || fail "off_policy.csv differs: $(diff whole/off_policy.csv parts/off_policy.csv | head -4)"
+steps=$(tail -n 1 whole/off_policy.csv | cut -d, -f6)
+[ "$steps" -gt 0 ] || fail "no gradient steps were taken ($steps)"
+# The state is sealed: a flipped byte is refused by name, nothing is resumed from it.
+cp -r parts damaged && printf '\xff' | dd of=damaged/off_policy_state.bin bs=1 seek=200 conv=notrunc status=none
+if "${train[@]}" --updates 14 --resume damaged > damaged.log 2>&1; then fail "a damaged off_policy_state.bin was resumed"; fi
+grep -q "off_policy_state.bin" damaged.log || fail "the refusal does not name the file: $(tail -n 2 damaged.log)"
+echo "PASS: resumed at 5, bit for bit the run never stopped to 12 ($steps gradient steps); a damaged state refused by name"

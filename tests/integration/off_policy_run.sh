@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Off-policy learning over LCM (issue #34, item 2), started as a user starts it: deploy/train.sh with
+# `--set learner=off_policy`, a signed run (its default), a learner and 2 actor processes over real
+# multicast (udpm, ttl=0). The actors stream their rollouts, the learner keeps them in its replay
+# buffer and takes SAC's gradient steps. Passes when
+#  - both actors' data reached the learner and every round's gradient steps are the ones owed
+#    (floor(updates_per_step x transitions past learning_starts), minus the steps of the rounds before);
+#  - it learned: the mean training return of the last 8 rounds is at least twice that of rounds 5-12
+#    (the first rounds of the policy, after the uniform warm-up) and above 20 (uniformly random
+#    actions earn 6-13 here);
+#  - the run's policy.bin is read by masa_eval as an ordinary policy file.
+#   MASA_BUILD_DIR=build bash tests/integration/off_policy_run.sh [PORT]
+# Prints PASS and exits 0, or FAIL with the logs' tails and exits 1. About 60-120 s.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+source tests/integration/lib.sh
+
+port=${1:-7731}
+begin_local_run off_policy "$port"
+rounds=40 envs=8 horizon=32 starts=1024 ups=0.5
+log "deploy/train.sh a1_beam masa, learner off_policy, 2 actors x $envs envs, $rounds rounds, on $url (work dir $work)"
+OMP_NUM_THREADS=1 MASA_BUILD_DIR=$build MASA_LCM_URL=$url bash deploy/train.sh a1_beam masa --actors 2 --envs $envs \
+  --updates $rounds --run-dir "$run" --set learner=off_policy --set ppo.horizon=$horizon \
+  --set sac.learning_starts=$starts --set sac.updates_per_step=$ups --set sac.batch_size=128 \
+  --set "sac.policy_hidden=[64,64]" --set "sac.q_hidden=[64,64]" --set runner.eval_every=0 --set runner.plot_every=0 \
+  > "$work/train.log" 2>&1 &
+train_pid=$!
+started_pids+=("$train_pid")
+wait "$train_pid" || fail "train.sh did not finish cleanly"
+[ "$(updates_in "$run")" -eq "$rounds" ] || fail "$(updates_in "$run") rounds in metrics.csv, not $rounds"
+for a in 0 1; do grep -q "actor $a joined" "$work/train.log" "$run"/*.log 2> /dev/null || fail "actor $a never joined"; done
+
+# Each round's gradient steps (off_policy.csv) are the ones its data owed, and the policy lag stays
+# within ppo.max_policy_lag (0: every round's data acted with the newest parameters).
+awk -F, -v starts=$starts -v ups=$ups -v per=$((2 * envs * horizon)) '
+  NR == 1 { for (c = 1; c <= NF; c++) col[$c] = c; next }
+  { n = NR - 1; got = n * per; owed = got >= starts ? int(ups * (got - starts + 1) + 1e-9) : 0
+    if ($col["gradient_steps"] != owed - before) { printf "FAIL: round %d took %s gradient steps, owed %d\n", n, $col["gradient_steps"], owed - before; exit }
+    if ($col["policy_lag_max"] != 0) { printf "FAIL: round %d has policy lag %s\n", n, $col["policy_lag_max"]; exit }
+    before = owed }' "$run/off_policy.csv" > "$work/verdict.txt"
+[ "$(wc -l < "$run/off_policy.csv")" -eq $((rounds + 1)) ] || fail "off_policy.csv has $(wc -l < "$run/off_policy.csv") lines"
+awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) col[$c] = c; next }
+  { r[NR - 1] = $col["return"] }
+  END { for (n = 5; n <= 12; n++) early += r[n] / 8; for (n = NR - 8; n < NR; n++) late += r[n] / 8
+        printf "training return: rounds 5-12 %.1f, last 8 %.1f\n", early, late
+        if (!(late >= 2 * early && late > 20)) print "FAIL: it did not learn" }' "$run/metrics.csv" | tee -a "$work/verdict.txt"
+grep -q FAIL "$work/verdict.txt" && fail "$(cat "$work/verdict.txt")"
+"$build/tools/masa_eval" "$run" --episodes 2 > "$work/eval.log" 2>&1 || fail "masa_eval refused the run's policy.bin: $(tail -n 3 "$work/eval.log")"
+echo "PASS: an off-policy run of 2 actors over LCM took every owed gradient step and learned ($(grep "^training return" "$work/verdict.txt" | sed 's/training return: //')); masa_eval read its policy"
