@@ -104,9 +104,9 @@ if [ "$ranks" -gt 1 ]; then
     { echo "train.sh: --ranks needs Open MPI's mpirun (bash scripts/install_deps.sh installs it, then build again)" >&2; exit 2; }
   (( actors % ranks == 0 )) || { echo "train.sh: $actors actors do not divide among $ranks learner ranks (each rank takes its share)" >&2; exit 2; }
   job=("$task" "$method" --ranks "$ranks" --actors "$actors" --envs "$envs" --updates "$updates")
-  [ "$no_auth" = 0 ] || job+=(--no-auth)
-  # An MPI job's processes take the run key from learner rank 0 over MPI: signed runs are one learner.
-  [ "$auth_mode" != signed ] || echo "train.sh: --ranks: messages authenticated with the job's run key (HMAC), not signed per process" >&2
+  # Signed: every process of the job makes its own key in memory and the public keys are gathered
+  # over MPI (no roster file, no key file); hmac: learner rank 0 hands RUN_DIR/run.key over MPI.
+  job+=(--auth "$auth_mode")
   if [ -n "$resume" ]; then
     for f in checkpoint.bin config.yaml; do
       [ -r "$resume/$f" ] || { echo "train.sh: $resume/$f is missing: not a run directory" >&2; exit 2; }
