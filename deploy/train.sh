@@ -17,7 +17,8 @@
 # channel (the learner's alone on MASA_POLICY, each actor's on its own rollouts and heartbeats), so a
 # stolen actor key can neither forge parameters nor another actor's rollouts; both are made here by
 # masa_roster before anything starts, kept on --resume, and with --hosts each host gets the roster
-# and only its own actors' keys, over the remote shell's stdin. --auth hmac authenticates with one
+# and only its own actors' keys, over the remote shell's stdin. With --ranks the MPI job's processes
+# make their keys in memory and gather the public keys over MPI (no key file). --auth hmac authenticates with one
 # run key, RUN_DIR/run.key, shared by all (any holder can forge anything; no replay protection);
 # --no-auth (--auth none) runs without (docs/reliability.md, "Message authentication").
 # MASA_BUILD_DIR (default build) and MASA_RUNS_DIR (default runs) choose the folders, MASA_LCM_URL
