@@ -4,7 +4,8 @@
 # Every process signs with its own key, made in memory; the public keys are gathered over MPI.
 #  1. The job trains to --max-updates and every process exits 0; rank 0 and both actors say they
 #     sign with a key made in memory; the run directory has no key file (no run.key, no keys/) and
-#     its job_roster lists learner 0 and the 3 actors, each with another key, and no learner rank 1.
+#     its job_roster lists learner 0 and the 3 actors, each with another key, and no learner rank 1;
+#     masa_lcm_probe --roster job_roster verifies the broadcasts and refuses the forged ones.
 #  2. The forging actor re-signs the learner's parameters with its actor key (version + 1000,
 #     parameters zeroed): both actors refuse every one (MASA_POLICY: not_permitted), and its unsigned
 #     copies (unauthenticated); no actor acted with a forged version (the learner dropped no chunk as
@@ -35,6 +36,11 @@ timeout 180 "$mpirun_sh" -np 2 "$learner_bin" "${sets[@]}" --url "$url" --max-up
   : -np 2 "$actor_bin" "${sets[@]}" --num-envs 8 --await-params-s 5 \
   : -np 1 "$forger_bin" > "$work/job.log" 2>&1 &
 launcher=$!
+# A watcher with the job's roster (public keys only) verifies its broadcasts as an actor does.
+for _ in $(seq 1 200); do [ -f "$run/job_roster" ] && break; sleep 0.05; done
+"$build/tools/masa_lcm_probe" --url "$url" --channel MASA_POLICY --roster "$run/job_roster" --duration 2 --quiet \
+  > "$work/probe.log" 2>&1 &
+probe=$!
 # 3. Every command line of the job while it runs: paths and settings, never a key.
 for _ in $(seq 1 100); do
   [ -f "$run/metrics.csv" ] && break
@@ -55,7 +61,11 @@ grep -q "masa_learner: messages signed with a key made in memory (ed25519:" "$wo
   fail "job_roster: not 3 actors on their channels"
 grep -q '^learner 1 ' "$run/job_roster" && fail "job_roster lists learner rank 1, which publishes nothing"
 [ "$(awk '!/^#/ {print $3}' "$run/job_roster" | sort -u | wc -l)" -eq 4 ] || fail "job_roster: keys are not all different"
-log "   8 updates; signed with keys made in memory; job_roster: learner 0 and 3 actors"
+wait "$probe" || fail "masa_lcm_probe --roster job_roster failed: $(tail -n 3 "$work/probe.log")"
+awk '$1 == "MASA_POLICY" && $2 > 0 { found = 1 } END { exit !found }' "$work/probe.log" ||
+  fail "the watcher verified no parameter broadcast with job_roster: $(cat "$work/probe.log")"
+grep -q "rejected .* on MASA_POLICY" "$work/probe.log" || fail "the watcher refused no forged broadcast: $(cat "$work/probe.log")"
+log "   8 updates; signed with keys made in memory; job_roster: learner 0 and 3 actors; a watcher verifies with it"
 
 log "2. the forging actor's parameters and heartbeats are refused"
 grep -E "forging actor 2: heard [1-9][0-9]* parameter messages; sent [1-9][0-9]* re-signed" "$work/job.log" ||
