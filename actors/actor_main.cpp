@@ -22,6 +22,7 @@
 #include "common/config/run_config.hpp"
 #include "common/cluster/job_plan.hpp"
 #include "common/cluster/mpi_job.hpp"
+#include "common/transport/job_roster.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/run_key.hpp"
 
@@ -32,7 +33,8 @@ extern "C" void onSignal(int) { g_stop.store(true); }
 
 int main(int argc, char** argv) {
   // Started by mpirun or srun beside the learner ranks (docs/scaling.md): the job says who this
-  // actor is, which run, and where its rollouts go; no key file, run id or URL is needed.
+  // actor is, which run, where its rollouts go, and how to authenticate (a signed job: its own key,
+  // made in memory, and the roster gathered over MPI); no key file, run id or URL is needed.
   std::unique_ptr<masa::cluster::MpiJob> job;
   try {
     if (masa::cluster::launchedByMpi()) job = std::make_unique<masa::cluster::MpiJob>(masa::cluster::Role::kActor);
@@ -101,6 +103,10 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (job) {
     try {
+      // Before the plan, as every process of the job does (job_roster.hpp).
+      auto job_keys = masa::transport::jobSignedMode(
+          {masa::transport::Role::kActor, static_cast<uint32_t>(job->roleIndex())},
+          [&](const std::vector<uint8_t>& mine) { return job->gatherFromEveryProcess(mine); });
       std::vector<uint8_t> bytes;
       job->shareFromLearnerZero(bytes);
       const auto plan = masa::cluster::JobPlan::decode(bytes);
@@ -115,8 +121,9 @@ int main(int argc, char** argv) {
         k.bytes = *plan.key;
         opt.run_key = k;
       }
-      no_auth = !plan.key;
-      key_file = plan.key ? "(from learner rank 0)" : "";
+      if (plan.signed_job) opt.signed_mode = std::move(job_keys);
+      no_auth = !plan.key && !plan.signed_job;
+      key_file = plan.key ? "(from learner rank 0)" : plan.signed_job ? "(a key made in memory)" : "";
     } catch (const std::exception& e) {
       std::fprintf(stderr, "masa_actor: %s\n", e.what());
       job->abort(2);
@@ -135,9 +142,15 @@ int main(int argc, char** argv) {
   try {
     const auto rc = masa::config::loadRunConfig(configs, overrides, run_config);
     if (job) {
-      std::fprintf(stderr, "masa_actor %d: actor %d of %d in an MPI job, rollouts to learner rank %d on %s\n",
+      std::fprintf(stderr, "masa_actor %d: actor %d of %d in an MPI job, rollouts to learner rank %d on %s; %s%s\n",
                    opt.actor_id, opt.actor_id, job->actorCount(), opt.actor_id % job->learnerCount(),
-                   opt.rollout_url.c_str());
+                   opt.rollout_url.c_str(),
+                   opt.signed_mode ? "messages signed with a key made in memory, "
+                   : opt.run_key   ? "messages authenticated with the job's run key"
+                                   : "WARNING: no message authentication (--no-auth)",
+                   opt.signed_mode ? (masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()) +
+                                      ", senders checked against the roster of the MPI job").c_str()
+                                   : "");
     } else if (!roster_file.empty()) {
       opt.signed_mode = masa::transport::loadSignedMode(
           roster_file, signing_key, {masa::transport::Role::kActor, static_cast<uint32_t>(opt.actor_id)});

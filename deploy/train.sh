@@ -17,7 +17,8 @@
 # channel (the learner's alone on MASA_POLICY, each actor's on its own rollouts and heartbeats), so a
 # stolen actor key can neither forge parameters nor another actor's rollouts; both are made here by
 # masa_roster before anything starts, kept on --resume, and with --hosts each host gets the roster
-# and only its own actors' keys, over the remote shell's stdin. --auth hmac authenticates with one
+# and only its own actors' keys, over the remote shell's stdin. With --ranks the MPI job's processes
+# make their keys in memory and gather the public keys over MPI (no key file). --auth hmac authenticates with one
 # run key, RUN_DIR/run.key, shared by all (any holder can forge anything; no replay protection);
 # --no-auth (--auth none) runs without (docs/reliability.md, "Message authentication").
 # MASA_BUILD_DIR (default build) and MASA_RUNS_DIR (default runs) choose the folders, MASA_LCM_URL
@@ -104,9 +105,9 @@ if [ "$ranks" -gt 1 ]; then
     { echo "train.sh: --ranks needs Open MPI's mpirun (bash scripts/install_deps.sh installs it, then build again)" >&2; exit 2; }
   (( actors % ranks == 0 )) || { echo "train.sh: $actors actors do not divide among $ranks learner ranks (each rank takes its share)" >&2; exit 2; }
   job=("$task" "$method" --ranks "$ranks" --actors "$actors" --envs "$envs" --updates "$updates")
-  [ "$no_auth" = 0 ] || job+=(--no-auth)
-  # An MPI job's processes take the run key from learner rank 0 over MPI: signed runs are one learner.
-  [ "$auth_mode" != signed ] || echo "train.sh: --ranks: messages authenticated with the job's run key (HMAC), not signed per process" >&2
+  # Signed: every process of the job makes its own key in memory and the public keys are gathered
+  # over MPI (no roster file, no key file); hmac: learner rank 0 hands RUN_DIR/run.key over MPI.
+  job+=(--auth "$auth_mode")
   if [ -n "$resume" ]; then
     for f in checkpoint.bin config.yaml; do
       [ -r "$resume/$f" ] || { echo "train.sh: $resume/$f is missing: not a run directory" >&2; exit 2; }

@@ -6,6 +6,9 @@
 // missing); --no-auth turns that off. In a signed run (--roster RUN_DIR/roster --signing-key
 // RUN_DIR/keys/learner0.key, made by masa_roster), the learner signs with its own key and believes
 // only the roster's actors on their own channels (common/transport/message_sign.hpp).
+// In an MPI job (mpirun, srun) it signs by default, with a key made in memory: every process of
+// the job makes its own and the public keys are gathered over MPI (common/transport/job_roster.hpp);
+// --key-file uses the run key instead, --no-auth nothing.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -14,6 +17,8 @@
 #include <ctime>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <optional>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -23,6 +28,7 @@
 #include "common/model/method.hpp"
 #include "common/cluster/job_plan.hpp"
 #include "common/cluster/mpi_job.hpp"
+#include "common/transport/job_roster.hpp"
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/run_key.hpp"
 #include "learner/intake/drop_reason.hpp"
@@ -43,6 +49,20 @@ std::string timestamp() {
   char buf[32];
   std::strftime(buf, sizeof(buf), "%Y%m%d-%H%M%S", &tm);
   return buf;
+}
+
+// RUN_DIR/job_roster, whole or not at all (written under a temporary name, then renamed).
+void writeJobRoster(const std::string& run_dir, const masa::transport::Roster& roster) {
+  const std::filesystem::path path = std::filesystem::path(run_dir) / "job_roster";
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << roster.format();
+    if (!out.flush()) throw std::runtime_error(tmp.string() + ": cannot write the job's roster");
+  }
+  std::filesystem::permissions(tmp, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
+                                        std::filesystem::perms::group_read | std::filesystem::perms::others_read);
+  std::filesystem::rename(tmp, path);
 }
 
 }  // namespace
@@ -78,7 +98,8 @@ int main(int argc, char** argv) {
   bool no_auth = false;
   auto* key_opt = app.add_option("--key-file", key_file,
                                  "the run key every message is authenticated with (default: RUN_DIR/run.key, made "
-                                 "when missing; give the actors the same file)");
+                                 "when missing; give the actors the same file). In an MPI job: authenticate with "
+                                 "this run key instead of signing");
   auto* no_auth_opt = app.add_flag("--no-auth", no_auth, "send and accept messages without authentication (anyone on the network can "
                                      "then feed this run rollouts)")->excludes(key_opt);
   std::string roster_file, signing_key;
@@ -118,6 +139,14 @@ int main(int argc, char** argv) {
                                            std::to_string(rc.seed) + "_" + timestamp();
     }
     if (max_updates < 0) max_updates = rc.ppo.max_updates;
+    // Collective over the whole job, whatever the authentication: the actors cannot know it before
+    // the plan, and a collective every process of the job enters must not depend on it.
+    std::optional<masa::transport::SignedMode> job_keys;
+    if (job)
+      job_keys = masa::transport::jobSignedMode(
+          {masa::transport::Role::kLearner, static_cast<uint32_t>(ranks->rank())},
+          [&](const std::vector<uint8_t>& mine) { return job->gatherFromEveryProcess(mine); });
+    const bool signed_job = job && !no_auth && key_file.empty();
     if (ranks) {
       // Rank 0's run directory (its default has rank 0's timestamp) for every rank.
       std::vector<uint8_t> dir(opt.run_dir.begin(), opt.run_dir.end());
@@ -125,11 +154,19 @@ int main(int argc, char** argv) {
       opt.run_dir.assign(dir.begin(), dir.end());
     }
     if (!roster_file.empty()) {
-      if (ranks) throw std::runtime_error("--roster: signed runs have one learner process (ranks use the MPI job's run key)");
+      if (job) throw std::runtime_error("--roster: an MPI job signs with keys its processes make in memory and gathers "
+                                        "their public keys over MPI; leave out --roster and --signing-key");
       opt.signed_mode = masa::transport::loadSignedMode(roster_file, signing_key, {masa::transport::Role::kLearner, 0});
       std::cout << "masa_learner: messages signed with " << signing_key << " ("
                 << masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()) << "), senders checked against the roster "
                 << roster_file << " (" << opt.signed_mode->roster->entries().size() << " senders)" << std::endl;
+    } else if (signed_job) {
+      opt.signed_mode = *job_keys;
+      if (lead)
+        std::cout << "masa_learner: messages signed with a key made in memory ("
+                  << masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey())
+                  << "), senders checked against the roster of the MPI job (" << opt.signed_mode->roster->entries().size()
+                  << " senders)" << std::endl;
     } else if (no_auth) {
       std::cerr << "masa_learner: WARNING: --no-auth: messages are neither signed nor checked; anyone who can "
                    "reach this network can feed this run rollouts\n";
@@ -140,7 +177,7 @@ int main(int argc, char** argv) {
       std::cout << "masa_learner: messages authenticated with the run key " << key_file << " (key id "
                 << opt.run_key->id() << ")" << std::endl;
     }
-    if (ranks && !no_auth) {
+    if (ranks && !no_auth && !signed_job) {
       // Rank 0's key for the other ranks, over MPI: never on a command line or in a shared file.
       std::vector<uint8_t> key;
       if (lead) key.assign(opt.run_key->bytes.begin(), opt.run_key->bytes.end());
@@ -163,6 +200,10 @@ int main(int argc, char** argv) {
       plan.run_id = learner.runId();
       plan.url = url;
       if (opt.run_key) plan.key = opt.run_key->bytes;
+      plan.signed_job = signed_job;
+      // The job's roster, public, for a watcher (masa_lcm_probe --roster RUN_DIR/job_roster); the
+      // job itself never reads it. A new job writes its own (new keys).
+      if (lead && signed_job) writeJobRoster(learner.runDir(), *opt.signed_mode->roster);
       std::vector<uint8_t> bytes = lead ? plan.encode() : std::vector<uint8_t>{};
       job->shareFromLearnerZero(bytes);
     }
@@ -193,8 +234,11 @@ int main(int argc, char** argv) {
                 << learner.unacknowledgedRepeats() << "; actors that acknowledged parameters "
                 << learner.acknowledgingActors() << std::endl;
     std::cout << who << ": MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
-    std::cout << who << ": other messages rejected before decoding: " << learner.transport().rejectSummary()
-              << std::endl;
+    std::cout << who << ": other messages rejected before decoding: " << learner.transport().rejectSummary();
+    // Rank 0 of several hears the actors' heartbeats on the parameters' URL, another transport.
+    if (&learner.publisher() != &learner.transport())
+      std::cout << "; on the parameters' URL " << learner.publisher().rejectSummary();
+    std::cout << std::endl;
     // Stopped because a rank heard nothing: not the run's end, so not success for a job script,
     // and the job's actors end with it (MPI_Abort), hung or not.
     if (cut_short) {

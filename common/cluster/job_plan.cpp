@@ -19,8 +19,10 @@ std::vector<uint8_t> JobPlan::encode() const {
   const uint32_t url_size = static_cast<uint32_t>(url.size());
   put(&url_size, sizeof url_size);
   put(url.data(), url.size());
-  const uint8_t has_key = key ? 1 : 0;
-  put(&has_key, 1);
+  if (key && signed_job) throw std::logic_error("job plan: a run key and a signed job exclude each other");
+  // The authentication byte: 0 none, 1 the run key follows, 2 signed.
+  const uint8_t auth = signed_job ? 2 : key ? 1 : 0;
+  put(&auth, 1);
   if (key) put(key->data(), key->size());
   return out;
 }
@@ -42,10 +44,11 @@ JobPlan JobPlan::decode(const std::vector<uint8_t>& bytes) {
   if (url_size > 4096) throw std::runtime_error("job plan from learner rank 0: URL of " + std::to_string(url_size) + " bytes");
   plan.url.resize(url_size);
   take(plan.url.data(), url_size);
-  uint8_t has_key = 0;
-  take(&has_key, 1);
-  if (has_key > 1) throw std::runtime_error("job plan from learner rank 0: bad key flag");
-  if (has_key) {
+  uint8_t auth = 0;
+  take(&auth, 1);
+  if (auth > 2) throw std::runtime_error("job plan from learner rank 0: bad authentication byte " + std::to_string(auth));
+  plan.signed_job = auth == 2;
+  if (auth == 1) {
     plan.key.emplace();
     take(plan.key->data(), plan.key->size());
   }

@@ -1,5 +1,6 @@
 #include "common/cluster/mpi_job.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
@@ -172,6 +173,25 @@ void MpiJob::shareFromLearnerZero(std::vector<uint8_t>& bytes) {
   if (n > 0) check(MPI_Bcast(bytes.data(), static_cast<int>(n), MPI_BYTE, root, MPI_COMM_WORLD), "MPI_Bcast");
 }
 
+std::vector<uint8_t> MpiJob::gatherFromEveryProcess(const std::vector<uint8_t>& mine) {
+  const int64_t n = static_cast<int64_t>(mine.size());
+  std::vector<int64_t> sizes(static_cast<std::size_t>(world_size_));
+  check(MPI_Allgather(&n, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, MPI_COMM_WORLD), "MPI_Allgather");
+  // Every process sees every size, so all of them throw alike (none waits in the gather below).
+  if (std::any_of(sizes.begin(), sizes.end(), [&](int64_t s) { return s != n; })) {
+    std::string each;
+    for (int r = 0; r < world_size_; ++r)
+      each += (r ? ", process " : "process ") + std::to_string(r) + ": " + std::to_string(sizes[static_cast<std::size_t>(r)]);
+    throw std::runtime_error("gatherFromEveryProcess: the processes give unequal byte counts (" + each + ")");
+  }
+  std::vector<uint8_t> all(mine.size() * static_cast<std::size_t>(world_size_));
+  if (n > 0)
+    check(MPI_Allgather(mine.data(), static_cast<int>(n), MPI_BYTE, all.data(), static_cast<int>(n), MPI_BYTE,
+                        MPI_COMM_WORLD),
+          "MPI_Allgather");
+  return all;
+}
+
 void MpiJob::finishTraining() {
   if (role_ != Role::kLearner) throw std::logic_error("finishTraining: only learner ranks end training");
   if (impl_->done_seen) return;
@@ -210,6 +230,7 @@ MpiJob::MpiJob(Role role) : role_(role) {
 MpiJob::~MpiJob() = default;
 Communicator& MpiJob::learners() { return soloCommunicator(); }
 void MpiJob::shareFromLearnerZero(std::vector<uint8_t>&) {}
+std::vector<uint8_t> MpiJob::gatherFromEveryProcess(const std::vector<uint8_t>& mine) { return mine; }
 void MpiJob::finishTraining() {}
 bool MpiJob::trainingFinished() { return false; }
 void MpiJob::abort(int code) { std::_Exit(code); }

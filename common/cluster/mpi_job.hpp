@@ -49,6 +49,10 @@ class MpiJob {
   // Collective over the whole job: learner rank 0's bytes to every process (the run's plan: key,
   // run id, channels). Call it once, at the same point of every process's start.
   void shareFromLearnerZero(std::vector<uint8_t>& bytes);
+  // Collective over the whole job: every process's bytes, concatenated in world-rank order (a
+  // signed job's public keys, job_roster.hpp). Every process must give as many bytes; throws
+  // std::runtime_error naming the sizes otherwise.
+  std::vector<uint8_t> gatherFromEveryProcess(const std::vector<uint8_t>& mine);
 
   // Training is over. Learners: say so (every learner rank must call it; returns once all have).
   // Actors: poll it in their loop (true once every learner rank has said it).

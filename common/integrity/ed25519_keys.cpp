@@ -82,6 +82,13 @@ SigningKey SigningKey::load(const std::string& path) {
   return SigningKey(std::move(pkey));
 }
 
+SigningKey SigningKey::generate() {
+  auto pkey = std::make_shared<Pkey>();
+  pkey->key = EVP_PKEY_Q_keygen(nullptr, nullptr, "ED25519");
+  if (!isEd25519(pkey->key)) throw std::runtime_error("Ed25519: key generation failed");
+  return SigningKey(std::move(pkey));
+}
+
 SignatureBytes SigningKey::sign(std::string_view message) const {
   SignatureBytes sig{};
   std::size_t len = sig.size();

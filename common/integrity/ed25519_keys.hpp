@@ -24,6 +24,8 @@ class SigningKey {
   // Reads a PEM private key; throws std::runtime_error naming the file when it is missing, not an
   // Ed25519 key, or readable by others than its owner.
   static SigningKey load(const std::string& path);
+  // A new key that lives only in this process's memory (an MPI job's processes: nothing to carry).
+  static SigningKey generate();
   SignatureBytes sign(std::string_view message) const;
   PublicKeyBytes publicKey() const { return public_; }
 

@@ -46,6 +46,9 @@ std::vector<std::string> defaultChannels(Role role);
 
 class Roster {
  public:
+  Roster() = default;
+  // An empty roster that errors name as `source` (one built in memory, e.g. an MPI job's).
+  explicit Roster(std::string source) : source_(std::move(source)) {}
   struct Entry {
     SenderId id;
     integrity::PublicKeyBytes key{};

@@ -2,11 +2,15 @@
 # Trains as one MPI job: L data-parallel learner ranks and A actor processes, started, placed and
 # stopped by mpirun (Open MPI), on this machine or on the hosts of an Open MPI hostfile. Every
 # process learns its role and place from the job (docs/scaling.md): actor i sends its rollouts to
-# learner rank i mod L on that rank's own multicast port; learner rank 0 broadcasts the parameters,
-# writes the run directory and hands the run key to every process over MPI (never on a command
-# line). Ctrl-C stops the job; its checkpoint is resumable with --resume.
+# learner rank i mod L on that rank's own multicast port; learner rank 0 broadcasts the parameters
+# and writes the run directory. --auth signed (the default): every process signs with its own key,
+# made in memory, and the public keys are gathered over MPI (RUN_DIR/job_roster is their list, for
+# a watcher); --auth hmac: learner rank 0 hands the run key RUN_DIR/run.key to every process over
+# MPI; --auth none (or --no-auth): nothing. No key is ever on a command line. Ctrl-C stops the job;
+# its checkpoint is resumable with --resume.
 #   deploy/cluster/mpirun_train.sh [task] [method] [--ranks L] [--actors A] [--envs E] [--threads T]
-#       [--hostfile FILE] [--updates N] [--run-dir DIR | --resume DIR] [--no-auth] [--set key=value ...]
+#       [--hostfile FILE] [--updates N] [--run-dir DIR | --resume DIR] [--auth signed|hmac|none] [--no-auth]
+#       [--set key=value ...]
 #       [-- extra mpirun options]
 # Defaults: 2 ranks, 2 actors of 32 environments, 1 thread each; ppo.num_envs = A x E, which the
 # ranks share equally. With --hostfile the URL is LAN multicast (ttl=1); see
@@ -18,7 +22,7 @@ cd "$(dirname "$0")/../.."
 task=a1_beam method=masa
 [ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; shift; }
 [ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; shift; }
-ranks=2 actors=2 envs=32 threads=1 hostfile="" updates="" run_dir="" resume="" no_auth=0
+ranks=2 actors=2 envs=32 threads=1 hostfile="" updates="" run_dir="" resume="" auth=signed
 sets=() mpi_extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -31,7 +35,8 @@ while [ $# -gt 0 ]; do
     --run-dir) run_dir=$2; shift 2 ;;
     --resume) resume=$2; shift 2 ;;
     --set) sets+=(--set "$2"); shift 2 ;;
-    --no-auth) no_auth=1; shift ;;
+    --auth) auth=$2; shift 2 ;;
+    --no-auth) auth=none; shift ;;
     --) shift; mpi_extra=("$@"); break ;;
     *) echo "mpirun_train.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -39,6 +44,12 @@ done
 for n in "$ranks" "$actors" "$envs" "$threads"; do
   [[ $n =~ ^[1-9][0-9]*$ ]] || { echo "mpirun_train.sh: '$n' is not a positive count" >&2; exit 2; }
 done
+case "$auth" in
+  signed | hmac | none) ;;
+  *) echo "mpirun_train.sh: --auth '$auth': expected signed, hmac or none" >&2; exit 2 ;;
+esac
+[ "$auth" != hmac ] || [ -n "$run_dir$resume" ] ||
+  { echo "mpirun_train.sh: --auth hmac needs --run-dir or --resume (the run key is RUN_DIR/run.key)" >&2; exit 2; }
 (( actors % ranks == 0 )) || { echo "mpirun_train.sh: $actors actors do not divide among $ranks ranks" >&2; exit 2; }
 build=${MASA_BUILD_DIR:-build}
 for bin in "$build/learner/masa_learner" "$build/actors/masa_actor"; do
@@ -55,7 +66,9 @@ fi
 config=(--set "task=$task" --set "method=$method" --set "ppo.num_envs=$((actors * envs))" "${sets[@]}")
 learner_args=(--url "$url")
 [ -n "$updates" ] && learner_args+=(--max-updates "$updates")
-[ "$no_auth" = 0 ] || learner_args+=(--no-auth)  # the actors learn it from the job's plan
+# The learner ranks sign by default in a job; the actors learn the mode from the job's plan.
+[ "$auth" != none ] || learner_args+=(--no-auth)
+[ "$auth" != hmac ] || learner_args+=(--key-file "${resume:-$run_dir}/run.key")
 if [ -n "$resume" ]; then
   learner_args+=(--resume "$resume")
   config=("${sets[@]}")

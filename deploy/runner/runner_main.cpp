@@ -6,6 +6,9 @@
 // (deploy/runner/policy_runner.hpp). Ctrl-C publishes the safe command before it exits.
 // --require-signed --trusted-keys KEYS refuses a policy file not signed by one of the Ed25519 public
 // keys in KEYS (a .pub file, or a directory of them; masa_seal keygen / sign make them).
+// --roster ROSTER --signing-key KEY signs every command as `runner 0` of the roster (masa_roster make
+// DIR --runner makes DIR/roster and DIR/keys/runner0.key), for a robot side that verifies commands
+// (masa_sim_robot --roster ROSTER); the state is still read unsigned.
 // Exit codes: 0 stopped (signal, --duration, --max-policy-steps), 2 error, 3 start guard refused or
 // another runner appeared, 4 stopped by the watchdog or the emergency stop (--exit-on-trip).
 #include <CLI/CLI.hpp>
@@ -21,6 +24,7 @@
 
 #include "common/core/build_info.hpp"
 #include "common/policy/policy_file.hpp"
+#include "common/transport/signed_publisher.hpp"
 #include "common/transport/transport.hpp"
 #include "deploy/runner/deploy_config.hpp"
 #include "deploy/runner/policy_runner.hpp"
@@ -124,6 +128,13 @@ int main(int argc, char** argv) {
   app.add_flag("--require-signed", require_signed, "refuse a policy file not signed by a key of --trusted-keys");
   app.add_option("--trusted-keys", trusted_keys_path, "Ed25519 public key file (PEM), or a directory of *.pub files")
       ->check(CLI::ExistingPath);
+  std::string roster_file, signing_key;
+  auto* roster_opt = app.add_option("--roster", roster_file,
+                                    "sign every command as runner 0 of this roster (masa_roster make DIR --runner), for "
+                                    "a robot side that verifies commands");
+  auto* key_opt = app.add_option("--signing-key", signing_key, "the runner's private key file (mode 0600), with --roster");
+  roster_opt->needs(key_opt);
+  key_opt->needs(roster_opt);
   CLI11_PARSE(app, argc, argv);
   if (require_signed != !trusted_keys_path.empty()) {
     std::fprintf(stderr, require_signed ? "masa_deploy: --require-signed needs --trusted-keys (the public keys a policy may be signed by)\n"
@@ -149,6 +160,14 @@ int main(int argc, char** argv) {
     deploy::PolicyRunner runner(lp, cfg, runner_id);
     const std::string scheduling = deploy::applyRealtime(cfg.realtime);  // before LCM starts its receive thread
     transport::Transport lcm(url.empty() ? cfg.lcm_url : url);
+    // Signed commands (opt-in): the key must be the one the roster gives runner 0.
+    std::shared_ptr<transport::MessageSigner> signer;
+    if (!roster_file.empty()) {
+      signer = transport::loadSignedMode(roster_file, signing_key, {transport::Role::kRunner, 0}).signer;
+      std::fprintf(stderr, "masa_deploy: commands signed as runner 0 with %s (%s), roster %s\n", signing_key.c_str(),
+                   integrity::keyFingerprint(signer->publicKey()).c_str(), roster_file.c_str());
+    }
+    transport::SignedPublisher commands(lcm, signer);
     std::fprintf(stderr,
                  "masa_deploy: task %s, method %s (equivariance error %.1e), %d joints, %.1f Hz, watchdog %.0f ms "
                  "(safe command within %.0f ms), state %s, commands %s, id %lld; %s%s\n",
@@ -164,6 +183,8 @@ int main(int argc, char** argv) {
     masa::lcmt_robot_command heard = runner.makeCommand();
     int64_t foreign = 0, foreign_id = 0;
     lcm.subscribeRaw(cfg.command_channel, [&](const void* data, int size) {
+      // Signed or not (another runner may sign): unverified, the start guard errs towards refusing.
+      size = transport::sizeWithoutSigTrailer(data, size);
       if (transport::decodeChecked(data, size, heard) == transport::WireVerdict::kOk && heard.runner_id != runner_id) {
         ++foreign;
         foreign_id = heard.runner_id;
@@ -211,7 +232,7 @@ int main(int argc, char** argv) {
       }
       if (runner.poll(now, cmd)) {
         const int64_t computed = steadyMicros();
-        lcm.publish(cfg.command_channel, cmd);
+        commands.publish(cfg.command_channel, cmd);
         ++published;
         if (runner.lastAnsweredRxUs() > 0) latency.add(runner.lastAnsweredRxUs(), now, computed, steadyMicros());
         if (!announced || runner.mode() != shown) {

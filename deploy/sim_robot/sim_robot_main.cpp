@@ -10,6 +10,10 @@
 // both report when the first safe command (mode >= 2) arrived after the fault; --tilt-state-after S
 // reports the base rolled by --tilt-rad more than it is (an IMU's view of a fall), and the robot
 // then reports its final joint angles and the fastest target change between emergency-stop commands.
+// --roster ROSTER: a robot side that verifies (issue #33, item 2): it takes a command only when it is
+// signed by a sender the roster lets publish on the command channel (runner 0, masa_roster make DIR
+// --runner; masa_deploy --roster --signing-key) and is new (counter window); others are refused and
+// counted by reason, printed at the end. Without it, commands are taken signed or not (unverified).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -27,6 +31,7 @@
 #include "common/policy/policy_file.hpp"
 #include "common/sim/registry.hpp"
 #include "common/transport/channels.hpp"
+#include "common/transport/signed_publisher.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_robot_command.hpp"
 #include "masa/lcmt_robot_state.hpp"
@@ -74,6 +79,9 @@ int main(int argc, char** argv) {
   app.add_option("--state-channel", state_channel)->capture_default_str();
   app.add_option("--command-channel", command_channel)->capture_default_str();
   app.add_flag("--quiet", quiet, "no per-second status line");
+  std::string roster_file;
+  app.add_option("--roster", roster_file,
+                 "take only commands signed by a sender this roster permits on the command channel (runner 0)");
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
@@ -104,6 +112,17 @@ int main(int argc, char** argv) {
       }
 
     transport::Transport lcm(url);
+    // With a roster, commands arrive through a transport that verifies every message (and cannot
+    // publish: the state goes out unsigned through `lcm`).
+    std::unique_ptr<transport::Transport> verifying;
+    if (!roster_file.empty()) {
+      transport::SignedMode watch;
+      watch.roster = std::make_shared<transport::Roster>(transport::Roster::load(roster_file));
+      verifying = std::make_unique<transport::Transport>(url, watch);
+      std::fprintf(stderr, "masa_sim_robot: commands verified against the roster %s (%zu senders)\n",
+                   roster_file.c_str(), watch.roster->entries().size());
+    }
+    transport::Transport& command_in = verifying ? *verifying : lcm;
     std::mt19937_64 fault(fault_seed);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     const auto t_start = Clock::now();
@@ -113,7 +132,10 @@ int main(int argc, char** argv) {
     std::vector<int64_t> runners;  // ids of the runners heard
     masa::lcmt_robot_command incoming{}, last_estop{};
     double estop_max_rate = 0;  // rad/s: the fastest target change between two emergency-stop commands
-    lcm.subscribeRaw(command_channel, [&](const void* data, int size) {
+    command_in.subscribeRaw(command_channel, [&](const void* data, int size) {
+      // Verified (the trailer already gone), or a robot that does not verify: a signing runner's
+      // trailer is not part of the command.
+      if (!verifying) size = transport::sizeWithoutSigTrailer(data, size);
       if (transport::decodeChecked(data, size, incoming) != transport::WireVerdict::kOk || incoming.num_joints != n) return;
       ++received;
       if (incoming.mode == 4) {
@@ -179,7 +201,7 @@ int main(int argc, char** argv) {
     while (!g_stop && !have_cmd) {
       publishState(0.0);
       const auto until = Clock::now() + std::chrono::duration<double>(dt * state_every);
-      while (Clock::now() < until) lcm.handleTimeout(1);
+      while (Clock::now() < until) command_in.handleTimeout(1);
       while (!pending.empty() && pending.front().deliver_at <= wall()) {
         cmd = pending.front().cmd;
         pending.pop_front();
@@ -190,7 +212,7 @@ int main(int argc, char** argv) {
     int last_status = 0;
     while (!g_stop && steps * dt < duration) {
       const double sim_t = steps * dt;
-      lcm.drain();
+      command_in.drain();
       const double now = wall();
       // The newest delivered command wins (jitter may deliver out of order).
       for (auto it = pending.begin(); it != pending.end();) {
@@ -245,6 +267,8 @@ int main(int argc, char** argv) {
     }
     mj_kinematics(m, d);
     std::printf("masa_sim_robot: commands from %zu runner(s)\n", runners.size());
+    if (verifying)
+      std::printf("masa_sim_robot: commands refused before decoding: %s\n", verifying->rejectSummary().c_str());
     std::printf("masa_sim_robot: %.2f s simulated, %lld commands received (%lld lost), %lld states lost; command modes:"
                 " calibrating %lld, policy %lld, damping %lld, hold %lld, estop %lld physics steps\n",
                 steps * dt, static_cast<long long>(received), static_cast<long long>(lost_commands),

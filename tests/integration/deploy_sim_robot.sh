@@ -16,6 +16,12 @@
 #                 into configs/deploy/a1_beam_sim.yaml's crouch pose, targets no faster than its rate
 #   refusals      the shipped TriFinger Lift, Ant Acrobatic and Humanoid Dribbling policies are
 #                 refused with their configs, naming the object the robot cannot measure
+#   signed_commands  the runner signs its commands as runner 0 of a roster (masa_roster make --runner)
+#                 and the robot verifies them (--roster): it walks under the runner's commands while a
+#                 forger's replays, changed commands (an emergency stop) signed with an actor's key of
+#                 the roster and unsigned ones are refused and counted (replayed, not_permitted,
+#                 unauthenticated) and none is taken (no physics step in mode 4); a robot that does not verify takes the signed commands too; a verifying
+#                 robot refuses every command of an unsigned runner and never moves
 # A real-time runner on a loaded machine can miss its state for 50 ms and trip its watchdog, which is
 # the watchdog doing its job, not what these cases test: walk, walk_tuned, faults and crouch (and
 # stale and nan, for a trip before their fault) say such a run and try it once more; a second trip
@@ -219,5 +225,46 @@ refusals)
   done
   echo "PASS: TriFinger Lift, Ant Acrobatic and Humanoid Dribbling are refused, naming what the robot cannot measure"
   ;;
-*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals PORT"; exit 2 ;;
+signed_commands)
+  roster_bin="$build/tools/masa_roster"
+  forger="$build/tests/masa_test_robot_command_forger"
+  for b in "$roster_bin" "$forger"; do [ -x "$b" ] || fail "$b is missing: build first"; done
+  "$roster_bin" make "$work/keys" --actors 1 --runner > "$work/roster.log" 2>&1 || fail "masa_roster make failed"
+  roster="$work/keys/roster"
+  signing=(--roster "$roster" --signing-key "$work/keys/keys/runner0.key")
+  # 1. A verifying robot, the signed runner, and the forger with the actor's key.
+  "$sim" "$policy" --seed 0 --duration 4.5 --quiet --roster "$roster" > "$work/sim.log" 2>&1 & pids+=($!)
+  "$forger" --roster "$roster" --signing-key "$work/keys/keys/actor0.key" --actor 0 --duration 8 \
+    > "$work/forger.log" 2>&1 & pids+=($!)
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" "${signing[@]}" --max-policy-steps 100 --quiet \
+    > "$work/deploy.log" 2>&1 || fail "the signing runner exited with $?"
+  wait "${pids[0]}" || fail "the verifying robot exited with $?"
+  wait "${pids[1]}" || fail "the forger exited with $?"
+  grep -q "masa_deploy: commands signed as runner 0 with .*runner0.key (ed25519:" "$work/deploy.log" || fail "the runner does not say it signs"
+  grep -q "policy phase" "$work/sim.log" || fail "the verifying robot took none of the runner's policy commands"
+  grep -q "commands from 1 runner(s)" "$work/sim.log" || fail "the robot heard another runner: $(grep 'runner(s)' "$work/sim.log")"
+  grep -q "estop 0 physics steps" "$work/sim.log" || fail "the robot took a forged emergency stop: $(grep 'command modes' "$work/sim.log")"
+  grep -q "fell: no" "$work/sim.log" || fail "the robot fell under the signed runner"
+  refused=$(grep "commands refused before decoding" "$work/sim.log") || fail "the verifying robot did not count refusals"
+  grep -qE "robot command forger: [1-9][0-9]* replays, [1-9][0-9]* commands signed by actor 0, [1-9][0-9]* unsigned" \
+    "$work/forger.log" || fail "the forger sent nothing: $(cat "$work/forger.log")"
+  for reason in replayed not_permitted unauthenticated; do
+    [[ $refused =~ MASA_ROBOT_COMMAND:\ [^\;]*$reason\ [1-9] ]] || fail "no $reason command refused: $refused"
+  done
+  echo "verifying robot: $refused; $(grep -o 'forger: .*' "$work/forger.log")"
+  # 2. A robot that does not verify takes the signed commands (the trailer is not part of them).
+  "$sim" "$policy" --seed 0 --duration 2.5 --quiet > "$work/sim2.log" 2>&1 & pids+=($!)
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" "${signing[@]}" --max-policy-steps 20 --quiet \
+    > "$work/deploy2.log" 2>&1 || fail "the signing runner exited with $? beside a robot that does not verify"
+  wait "${pids[2]}"
+  grep -q "policy phase" "$work/sim2.log" || fail "a robot that does not verify took none of the signed commands"
+  # 3. An unsigned runner and a verifying robot: every command refused, the robot never starts.
+  "$sim" "$policy" --seed 0 --duration 2 --quiet --roster "$roster" > "$work/sim3.log" 2>&1 & pids+=($!)
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 2 --quiet > "$work/deploy3.log" 2>&1
+  kill -INT "${pids[3]}"; wait "${pids[3]}"
+  grep -q "commands from 0 runner(s)" "$work/sim3.log" || fail "the verifying robot took an unsigned command"
+  grep -qE "MASA_ROBOT_COMMAND: [^;]*unauthenticated [1-9]" "$work/sim3.log" || fail "the unsigned commands were not counted as unauthenticated"
+  echo "PASS: the robot took the runner's signed commands only; forged, replayed and unsigned ones were refused"
+  ;;
+*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands PORT"; exit 2 ;;
 esac

@@ -1,8 +1,9 @@
 // One MPI job of learner ranks and actors (MPMD), as a cluster launch makes it:
 //   mpirun -np 2 masa_test_mpi_job_roles learner : -np 3 masa_test_mpi_job_roles actor
 // Every process learns the job's shape and its index among its role; learner rank 0's bytes reach
-// every process; actors see training going on until every learner rank has ended it, then see it
-// over. Exit status 0 everywhere and "PASS" from learner rank 0 when all of that holds.
+// every process, and every process's bytes every process (unequal sizes refused by name); actors
+// see training going on until every learner rank has ended it, then see it over. Exit status 0
+// everywhere and "PASS" from learner rank 0 when all of that holds.
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -44,6 +45,21 @@ int main(int argc, char** argv) {
   if (learner && job.roleIndex() == 0) plan = {'r', 'u', 'n', 0, 255};
   job.shareFromLearnerZero(plan);
   expect(plan == std::vector<uint8_t>{'r', 'u', 'n', 0, 255}, "learner rank 0's bytes reach every process");
+
+  // Every process's bytes, in world-rank order (a signed job's public keys, job_roster.hpp).
+  const std::vector<uint8_t> all = job.gatherFromEveryProcess(
+      {static_cast<uint8_t>(learner ? 'L' : 'A'), static_cast<uint8_t>(job.roleIndex())});
+  expect(all == std::vector<uint8_t>{'L', 0, 'L', 1, 'A', 0, 'A', 1, 'A', 2},
+         "every process's bytes reach every process in world-rank order");
+  try {
+    // Sizes that differ are named, not read past: here every process gives 1 byte but rank 0 2.
+    job.gatherFromEveryProcess(std::vector<uint8_t>(job.worldRank() == 0 ? 2 : 1, 7));
+    expect(false, "a gather of unequal sizes is refused");
+  } catch (const std::runtime_error& e) {
+    expect(std::string(e.what()).find("unequal byte counts (process 0: 2, process 1: 1, process 2: 1") !=
+               std::string::npos,
+           e.what());
+  }
 
   if (learner) {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));  // "training"

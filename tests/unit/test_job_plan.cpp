@@ -7,6 +7,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/cluster/job_plan.hpp"
@@ -16,8 +17,10 @@ namespace {
 
 using masa::cluster::JobPlan;
 
-JobPlan samplePlan(bool with_key) {
+// with_key: the run key (HMAC); signed_job: a signed job; neither: --no-auth.
+JobPlan samplePlan(bool with_key, bool signed_job = false) {
   JobPlan plan;
+  plan.signed_job = signed_job;
   plan.run_id = 0x1234567890abcdefLL;
   plan.url = "udpm://239.255.76.67:7667?ttl=1&recv_buf_size=4194304";
   if (with_key) {
@@ -27,13 +30,27 @@ JobPlan samplePlan(bool with_key) {
   return plan;
 }
 
-TEST(JobPlan, RoundTripsWithAndWithoutAKey) {
-  for (bool with_key : {true, false}) {
-    const JobPlan plan = samplePlan(with_key);
+TEST(JobPlan, RoundTripsWithAKeySignedAndWithoutAuthentication) {
+  for (auto [with_key, signed_job] : {std::pair{true, false}, std::pair{false, true}, std::pair{false, false}}) {
+    const JobPlan plan = samplePlan(with_key, signed_job);
     const JobPlan back = JobPlan::decode(plan.encode());
     EXPECT_EQ(back.run_id, plan.run_id);
     EXPECT_EQ(back.url, plan.url);
     EXPECT_EQ(back.key, plan.key);
+    EXPECT_EQ(back.signed_job, signed_job);
+  }
+  // A plan cannot say both: an actor would not know which to use.
+  EXPECT_THROW(samplePlan(true, true).encode(), std::logic_error);
+}
+
+TEST(JobPlan, AnUnknownAuthenticationByteIsRefusedByName) {
+  std::vector<uint8_t> bytes = samplePlan(false, true).encode();
+  bytes.back() = 3;  // the last byte of a plan without a key: how it is authenticated
+  try {
+    JobPlan::decode(bytes);
+    FAIL() << "authentication byte 3 accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad authentication byte 3"), std::string::npos) << e.what();
   }
 }
 
@@ -50,8 +67,8 @@ TEST(JobPlan, EveryTruncationAndAnyTrailingByteIsRefused) {
 TEST(JobPlan, DamagedPlansAreRefusedOrReadExactlyAsTheirBytesSay) {
   std::mt19937_64 rng(11);
   int refused = 0, accepted = 0;
-  for (bool with_key : {true, false}) {
-    const std::vector<uint8_t> clean = samplePlan(with_key).encode();
+  for (auto [with_key, signed_job] : {std::pair{true, false}, std::pair{false, true}, std::pair{false, false}}) {
+    const std::vector<uint8_t> clean = samplePlan(with_key, signed_job).encode();
     const std::string original(clean.begin(), clean.end());
     for (int i = 0; i < 2000; ++i) {
       const masa::fuzz::FileMutation m = masa::fuzz::mutateFile(original, rng);
@@ -68,7 +85,7 @@ TEST(JobPlan, DamagedPlansAreRefusedOrReadExactlyAsTheirBytesSay) {
     }
   }
   // Most damage changes the length or the magic; a flipped bit in the URL or key is a valid plan.
-  EXPECT_GT(refused, 2000);
+  EXPECT_GT(refused, 3000);
   EXPECT_GT(accepted, 0);
 }
 
