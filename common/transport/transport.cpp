@@ -57,8 +57,8 @@ bool Transport::publishWire(const std::string& channel, const void* data, int si
 }
 
 bool Transport::publishRaw(const std::string& channel, const void* data, int size) {
-  if (verifier_ && !signer_) throw std::logic_error("masa transport: a watcher (roster, no signing key) cannot publish");
-  if (!auth_ && !signer_) return publishWire(channel, data, size);
+  // Unchanged bytes only without any authentication; a watcher goes on to publishBuffer's refusal.
+  if (!authenticates()) return publishWire(channel, data, size);
   std::lock_guard<std::mutex> lock(publish_mutex_);
   uint8_t* buf = publishBuffer(size);
   if (size > 0) std::memcpy(buf, data, static_cast<std::size_t>(size));
@@ -66,6 +66,7 @@ bool Transport::publishRaw(const std::string& channel, const void* data, int siz
 }
 
 uint8_t* Transport::publishBuffer(int size) {
+  if (verifier_ && !signer_) throw std::logic_error("masa transport: a watcher (roster, no signing key) cannot publish");
   const std::size_t needed =
       static_cast<std::size_t>(size) + (signer_ ? kSigTrailerBytes : auth_ ? kAuthTrailerBytes : 0);
   if (publish_buf_.size() < needed) publish_buf_.resize(needed);
@@ -73,7 +74,6 @@ uint8_t* Transport::publishBuffer(int size) {
 }
 
 bool Transport::sendPublishBuffer(const std::string& channel, int size) {
-  if (verifier_ && !signer_) throw std::logic_error("masa transport: a watcher (roster, no signing key) cannot publish");
   if (signer_) {
     signer_->seal(channel, publish_buf_.data(), size, publish_buf_.data() + size);
     size += kSigTrailerBytes;

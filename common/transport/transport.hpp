@@ -135,6 +135,7 @@ class Transport {
   int lcmHandle(int timeout_ms);
   void countRejected(const std::string& channel, WireVerdict why);
   // The reused publish buffer, with room for `size` bytes and a trailer; the caller holds publish_mutex_.
+  // Every sealed publish starts here, so here a watcher's publish is refused (std::logic_error).
   uint8_t* publishBuffer(int size);
   // Seals the first `size` bytes of the publish buffer (with a key) and publishes them.
   bool sendPublishBuffer(const std::string& channel, int size);
