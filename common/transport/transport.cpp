@@ -56,9 +56,16 @@ bool Transport::publishWire(const std::string& channel, const void* data, int si
   return lcm_->publish(channel, data, static_cast<unsigned int>(size)) == 0;
 }
 
+bool Transport::publishMessage(const std::string& channel, const OutgoingMessage& msg) {
+  std::lock_guard<std::mutex> lock(publish_mutex_);
+  const int size = msg.encoded_size(msg.msg);
+  if (!msg.encode(msg.msg, publishBuffer(size), size)) return false;
+  return sendPublishBuffer(channel, size);
+}
+
 bool Transport::publishRaw(const std::string& channel, const void* data, int size) {
-  if (verifier_ && !signer_) throw std::logic_error("masa transport: a watcher (roster, no signing key) cannot publish");
-  if (!auth_ && !signer_) return publishWire(channel, data, size);
+  // Unchanged bytes only without any authentication; a watcher goes on to publishBuffer's refusal.
+  if (!authenticates()) return publishWire(channel, data, size);
   std::lock_guard<std::mutex> lock(publish_mutex_);
   uint8_t* buf = publishBuffer(size);
   if (size > 0) std::memcpy(buf, data, static_cast<std::size_t>(size));
@@ -66,6 +73,7 @@ bool Transport::publishRaw(const std::string& channel, const void* data, int siz
 }
 
 uint8_t* Transport::publishBuffer(int size) {
+  if (verifier_ && !signer_) throw std::logic_error("masa transport: a watcher (roster, no signing key) cannot publish");
   const std::size_t needed =
       static_cast<std::size_t>(size) + (signer_ ? kSigTrailerBytes : auth_ ? kAuthTrailerBytes : 0);
   if (publish_buf_.size() < needed) publish_buf_.resize(needed);
@@ -73,7 +81,6 @@ uint8_t* Transport::publishBuffer(int size) {
 }
 
 bool Transport::sendPublishBuffer(const std::string& channel, int size) {
-  if (verifier_ && !signer_) throw std::logic_error("masa transport: a watcher (roster, no signing key) cannot publish");
   if (signer_) {
     signer_->seal(channel, publish_buf_.data(), size, publish_buf_.data() + size);
     size += kSigTrailerBytes;
@@ -171,6 +178,13 @@ Transport::SubscriptionId Transport::subscribeRaw(const std::string& channel, Ra
   return s.id;
 }
 
+Transport::SubscriptionId Transport::subscribeMessage(const std::string& channel, MessageHandler handler) {
+  return subscribeRaw(channel, [this, channel, handler = std::move(handler)](const void* data, int size) {
+    const WireVerdict verdict = handler.decode_and_take(data, size);
+    if (verdict != WireVerdict::kOk) countRejected(channel, verdict);
+  });
+}
+
 void Transport::unsubscribe(SubscriptionId id) {
   for (auto it = subs_.begin(); it != subs_.end(); ++it) {
     if (it->id == id) {
@@ -181,49 +195,12 @@ void Transport::unsubscribe(SubscriptionId id) {
   }
 }
 
-WireRejects Transport::rejected(const std::string& channel) const {
-  const auto it = rejects_.find(channel);
-  return it == rejects_.end() ? WireRejects{} : it->second.count;
-}
-
-std::string Transport::rejectSummary() const {
-  std::string out;
-  for (const auto& [channel, r] : rejects_) {
-    std::string reasons;
-    for (int v = 0; v < kNumWireVerdicts; ++v) {
-      if (r.count[v] == 0) continue;
-      if (!reasons.empty()) reasons += ", ";
-      reasons += std::string(wireVerdictName(static_cast<WireVerdict>(v))) + " " + std::to_string(r.count[v]);
-    }
-    if (reasons.empty()) continue;
-    if (!out.empty()) out += "; ";
-    out += channel + ": " + reasons;
-  }
-  return out.empty() ? "none" : out;
-}
-
 void Transport::countRejected(const std::string& channel, WireVerdict why) {
-  ++decode_errors_;
-  ChannelRejects& r = rejects_[channel];
-  ++r.count[static_cast<int>(why)];
-  ++r.unwarned;
-  // At most one line per channel every few seconds: a fuzzer must not fill the log.
-  constexpr auto kWarnInterval = std::chrono::seconds(5);
-  const auto now = std::chrono::steady_clock::now();
-  if (r.warned && now - r.last_warning < kWarnInterval) return;
-  int64_t total = 0;
-  for (int64_t n : r.count) total += n;
-  std::cerr << "masa transport: rejected " << r.unwarned << " message(s) on " << channel << " (latest: "
-            << wireVerdictName(why) << "); " << total << " rejected on this channel so far";
-  if (why == WireVerdict::kUnauthenticated && verifier_)
-    std::cerr << " (unsigned, or a signature that does not verify under the roster's key of the sender it names)";
-  else if (why == WireVerdict::kUnauthenticated)
-    std::cerr << " (unsigned, or signed with another key: do all processes of the run share its run.key? our key id "
-              << key_id_ << ")";
-  std::cerr << "\n";
-  r.warned = true;
-  r.last_warning = now;
-  r.unwarned = 0;
+  if (why != WireVerdict::kUnauthenticated) return rejects_.count(channel, why);
+  if (verifier_)
+    return rejects_.count(channel, why, "unsigned, or a signature that does not verify under the roster's key of the sender it names");
+  rejects_.count(channel, why,
+                 "unsigned, or signed with another key: do all processes of the run share its run.key? our key id " + key_id_);
 }
 
 int Transport::lcmHandle(int timeout_ms) {

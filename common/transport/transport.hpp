@@ -1,7 +1,8 @@
-// The one door to LCM: a lcm::LCM on a provider URL (udpm:// multicast, memq:// in-process for
-// tests, tcpq:// through a hub where multicast is not routed, file:// to replay a log), with typed
-// publish/subscribe and a bounded wait. Nothing above this layer includes lcm-cpp.hpp, so the
-// transport could be replaced without touching actors or the learner.
+// The one door to LCM, the MessageBus between processes (message_bus.hpp): a lcm::LCM on a
+// provider URL (udpm:// multicast, memq:// in-process for tests, tcpq:// through a hub where
+// multicast is not routed, file:// to replay a log), with typed publish/subscribe and a bounded
+// wait. Nothing above this layer includes lcm-cpp.hpp; LocalBus (local_bus.hpp) is the other
+// implementation, for one process.
 //
 // With a run key, it authenticates every message (message_auth.hpp): publishing appends the
 // key's trailer, and a received message without a valid one is counted (kUnauthenticated) and
@@ -11,18 +12,11 @@
 // publishing appends a SIG1 trailer (sender, counter, Ed25519 signature), and a received message
 // reaches handlers only when the roster lists its sender, lets it publish on the channel, its
 // signature verifies, an actor's chunk or heartbeat names that actor, and its counter is new;
-// otherwise it is counted under the first reason it fails.
-//
-// Threading: publish() may be called from any thread; handle*() and (un)subscribe() from one
-// thread (handlers run on the thread that calls handle*()).
+// otherwise it is counted under the first reason it fails. Threading: as MessageBus says.
 #pragma once
 
-#include <array>
-#include <chrono>
 #include <cstdint>
-#include <functional>
 #include <list>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -31,6 +25,7 @@
 
 #include "common/transport/lcm_url.hpp"
 #include "common/transport/message_auth.hpp"
+#include "common/transport/message_bus.hpp"
 #include "common/transport/message_sign.hpp"
 #include "common/transport/run_key.hpp"
 #include "common/transport/wire_guard.hpp"
@@ -62,11 +57,8 @@ struct SignedMode {
 // another key.
 SignedMode loadSignedMode(const std::string& roster_path, const std::string& key_path, SenderId id);
 
-class Transport {
+class Transport : public MessageBus {
  public:
-  using RawHandler = std::function<void(const void* data, int size)>;
-  using SubscriptionId = int;
-
   // "" uses LCM_DEFAULT_URL (or LCM's own default). Throws std::runtime_error when LCM cannot
   // start on the URL. For a udpm URL, warns on stderr when net.core.rmem_max is below the
   // requested recv_buf_size (see recvBufCheck()). With `key`, every message is authenticated.
@@ -74,7 +66,7 @@ class Transport {
   // Signed: throws std::invalid_argument without a roster. Without a signer it only watches: every
   // message is verified against the roster, and publishing throws std::logic_error.
   Transport(const std::string& url, const SignedMode& mode);
-  ~Transport();
+  ~Transport() override;
   Transport(const Transport&) = delete;
   Transport& operator=(const Transport&) = delete;
 
@@ -85,39 +77,26 @@ class Transport {
   // In a handler of a signed transport: the verified sender of the message being handled.
   const std::optional<SenderId>& currentSender() const { return current_sender_; }
 
-  // Encodes into a reused buffer, appends the run key's trailer (with a key) and publishes;
-  // returns false when LCM reports a failure. publishRaw does the same for encoded bytes.
-  template <class Msg>
-  bool publish(const std::string& channel, const Msg& msg);
-  bool publishRaw(const std::string& channel, const void* data, int size);
+  // publish<Msg> encodes into a reused buffer, appends the run key's trailer (with a key) and
+  // publishes; returns false when LCM reports a failure. publishRaw does the same for encoded bytes.
+  bool publishRaw(const std::string& channel, const void* data, int size) override;
   // The bytes exactly as given, with no trailer even with a key: what any machine on the LAN can
   // send. For tests and tools that forge or replay traffic.
   bool publishWire(const std::string& channel, const void* data, int size);
 
-  // Raw bytes, for handlers that decode into a reused message (rollout chunks: see
-  // RolloutAssembler::acceptEncoded) or only measure them; a handler that decodes must do so with
-  // decodeChecked(). Throws std::runtime_error when LCM cannot subscribe (udpm: its self test
-  // failed, e.g. a firewall drops the process's own multicast), rather than leaving a
-  // subscription that never receives anything.
-  SubscriptionId subscribeRaw(const std::string& channel, RawHandler handler);
-  // Decoded messages, each through the wire guard first (decodeChecked). A rejected message is
-  // counted under its channel and reason (rejected()), warned about at a rate limit, and skipped.
-  template <class Msg>
-  SubscriptionId subscribe(const std::string& channel, std::function<void(const Msg&)> handler);
-  void unsubscribe(SubscriptionId id);
+  // Raw bytes (rollout chunks: see RolloutAssembler::acceptEncoded). Throws std::runtime_error
+  // when LCM cannot subscribe (udpm: its self test failed, e.g. a firewall drops the process's own
+  // multicast), rather than leaving a subscription that never receives anything. A message
+  // without a valid tag (with a key) or signature (signed) is counted and never reaches a handler.
+  SubscriptionId subscribeRaw(const std::string& channel, RawHandler handler) override;
+  void unsubscribe(SubscriptionId id) override;
 
-  // Dispatches at most one message, waiting up to timeout_ms: >0 handled, 0 timed out, <0 error.
-  int handleTimeout(int timeout_ms);
-  // Dispatches every message already queued (without waiting); returns how many.
-  int drain();
+  int handleTimeout(int timeout_ms) override;
+  int drain() override;
 
-  // Messages rejected before their handler (no valid tag with a key, or subscribe()'s guard):
-  // on all channels, and on one per reason.
-  int64_t decodeErrors() const { return decode_errors_; }
-  WireRejects rejected(const std::string& channel) const;
-  // Every channel's rejects by reason in one line ("MASA_POLICY: malformed 12, unauthenticated 3;
-  // ..."), or "none": what a process says when it stops.
-  std::string rejectSummary() const;
+ protected:
+  bool publishMessage(const std::string& channel, const OutgoingMessage& msg) override;
+  SubscriptionId subscribeMessage(const std::string& channel, MessageHandler handler) override;
 
  private:
   struct Sub {
@@ -135,6 +114,7 @@ class Transport {
   int lcmHandle(int timeout_ms);
   void countRejected(const std::string& channel, WireVerdict why);
   // The reused publish buffer, with room for `size` bytes and a trailer; the caller holds publish_mutex_.
+  // Every sealed publish starts here, so here a watcher's publish is refused (std::logic_error).
   uint8_t* publishBuffer(int size);
   // Seals the first `size` bytes of the publish buffer (with a key) and publishes them.
   bool sendPublishBuffer(const std::string& channel, int size);
@@ -144,14 +124,6 @@ class Transport {
   std::unique_ptr<lcm::LCM> lcm_;
   std::list<Sub> subs_;  // stable addresses: LCM keeps a pointer to each
   SubscriptionId next_id_ = 0;
-  int64_t decode_errors_ = 0;
-  struct ChannelRejects {
-    WireRejects count{};
-    bool warned = false;
-    std::chrono::steady_clock::time_point last_warning{};
-    int64_t unwarned = 0;  // rejected since the last warning
-  };
-  std::map<std::string, ChannelRejects> rejects_;
   std::unique_ptr<MessageAuthenticator> auth_;  // null: no key
   std::string key_id_;                           // RunKey::id(), for the warnings
   std::shared_ptr<MessageSigner> signer_;     // null: not signed
@@ -167,26 +139,5 @@ class Transport {
   std::mutex publish_mutex_;
   std::vector<uint8_t> publish_buf_;
 };
-
-template <class Msg>
-bool Transport::publish(const std::string& channel, const Msg& msg) {
-  std::lock_guard<std::mutex> lock(publish_mutex_);
-  const int size = msg.getEncodedSize();
-  if (msg.encode(publishBuffer(size), 0, size) != size) return false;
-  return sendPublishBuffer(channel, size);
-}
-
-template <class Msg>
-Transport::SubscriptionId Transport::subscribe(const std::string& channel, std::function<void(const Msg&)> handler) {
-  return subscribeRaw(channel, [this, channel, handler = std::move(handler)](const void* data, int size) {
-    // A fresh message each time: the generated decoder leaves zero-length arrays untouched, so a
-    // reused one could keep stale contents. Only rollout chunks are frequent enough to matter,
-    // and they take the raw path.
-    Msg msg;
-    const WireVerdict verdict = decodeChecked(data, size, msg);
-    if (verdict != WireVerdict::kOk) return countRejected(channel, verdict);
-    handler(msg);
-  });
-}
 
 }  // namespace masa::transport

@@ -9,15 +9,6 @@
 #include "learner/offline/log_std_bounds.hpp"
 
 namespace masa::offline {
-namespace {
-template <typename S>
-nn::AdamConfig<S> adamWithRate(double lr) {
-  nn::AdamConfig<S> c;
-  c.lr = static_cast<S>(lr);
-  return c;
-}
-}  // namespace
-
 template <typename S>
 IqlTrainer<S>::IqlTrainer(model::ActorCritic<S>& model, TwinQ<S>& q, TwinQ<S>& q_target, const OfflineConfig& config,
                           double reward_scale)
@@ -26,9 +17,9 @@ IqlTrainer<S>::IqlTrainer(model::ActorCritic<S>& model, TwinQ<S>& q, TwinQ<S>& q
       q_target_(&q_target),
       config_(config),
       reward_scale_(static_cast<S>(reward_scale)),
-      actor_adam_(model.params(), adamWithRate<S>(config.learning_rate), 0, model.policyParamCount()),
-      value_adam_(model.params(), adamWithRate<S>(config.learning_rate), model.policyParamCount(), model.params().size()),
-      q_adam_(q.params(), adamWithRate<S>(config.learning_rate)),
+      actor_net_(model.params(), config.learning_rate, 0, model.policyParamCount()),
+      value_net_(model.params(), config.learning_rate, model.policyParamCount(), model.params().size()),
+      q_net_(q.params(), config.learning_rate, &q_target.params()),
       log_std_(model.actDim()),
       dlog_std_(model.actDim()),
       dzero_log_std_(Vec<S>::Zero(model.actDim())) {}
@@ -108,19 +99,19 @@ S IqlTrainer<S>::qLoss(const TransitionBatch<S>& batch) {
 template <typename S>
 IqlStats IqlTrainer<S>::step(const TransitionBatch<S>& batch) {
   stats_.value_loss = static_cast<double>(valueLoss(batch));
-  value_adam_.step();
+  value_net_.step();
 
   // optax's cosine_decay_schedule(lr, steps): lr (1 + cos(pi t / T)) / 2, reaching 0 at T.
   const double progress = std::min(1.0, static_cast<double>(steps_) / static_cast<double>(config_.steps));
   stats_.actor_lr = config_.learning_rate * 0.5 * (1.0 + std::cos(std::numbers::pi * progress));
-  actor_adam_.config().lr = static_cast<S>(stats_.actor_lr);
+  actor_net_.setLearningRate(stats_.actor_lr);
   stats_.actor_loss = static_cast<double>(actorLoss(batch));
-  actor_adam_.step();
+  actor_net_.step();
   clampLogStd<S>(*model_, static_cast<S>(config_.log_std_min), static_cast<S>(config_.log_std_max));
 
   stats_.q_loss = static_cast<double>(qLoss(batch));
-  q_adam_.step();
-  q_target_->moveTowards(*q_, static_cast<S>(config_.polyak));
+  q_net_.step();
+  q_net_.updateTarget(static_cast<S>(config_.polyak));
   ++steps_;
   return stats_;
 }

@@ -11,7 +11,7 @@
 #pragma once
 
 #include "common/model/actor_critic.hpp"
-#include "common/nn/adam.hpp"
+#include "common/nn/optimized_net.hpp"
 #include "learner/offline/offline_config.hpp"
 #include "learner/offline/transition_batch.hpp"
 #include "learner/offline/twin_q.hpp"
@@ -50,7 +50,7 @@ class IqlTrainer {
   TwinQ<S>* q_target_;
   OfflineConfig config_;
   S reward_scale_;
-  nn::Adam<S> actor_adam_, value_adam_, q_adam_;
+  nn::OptimizedNet<S> actor_net_, value_net_, q_net_;  // q_net_ moves q_target
   long long steps_ = 0;
   IqlStats stats_;  // figures of the losses last computed
 

@@ -1,5 +1,6 @@
 #include "learner/offline/twin_q.hpp"
 
+#include "common/nn/optimized_net.hpp"
 #include "learner/offline/state_action_maps.hpp"
 
 namespace masa::offline {
@@ -72,8 +73,7 @@ void TwinQ<S>::minQ(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions, Ma
 
 template <typename S>
 void TwinQ<S>::moveTowards(const TwinQ& online, S rate) {
-  MASA_CHECK(online.params_.size() == params_.size(), "target and online Q differ in shape");
-  params_.values() += rate * (online.params_.values() - params_.values());
+  nn::polyakUpdate(online.params_, params_, rate);
 }
 
 template class TwinQ<float>;

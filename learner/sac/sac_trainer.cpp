@@ -12,13 +12,6 @@
 
 namespace masa::sac {
 namespace {
-template <typename S>
-nn::AdamConfig<S> adamWithRate(double lr) {
-  nn::AdamConfig<S> c;
-  c.lr = static_cast<S>(lr);
-  return c;
-}
-
 // The temperature's one parameter, log alpha (so that alpha stays positive), ready for its Adam.
 template <typename S>
 nn::ParameterSet<S>& logAlphaSet(nn::ParameterSet<S>& set, double init_alpha) {
@@ -37,9 +30,9 @@ SacTrainer<S>::SacTrainer(SacPolicy<S>& policy, offline::TwinQ<S>& q, offline::T
       q_target_(&q_target),
       config_(config),
       target_entropy_(config.target_entropy_per_dim * policy.actDim()),
-      policy_adam_(policy.params(), adamWithRate<S>(config.policy_lr)),
-      q_adam_(q.params(), adamWithRate<S>(config.q_lr)),
-      alpha_adam_(logAlphaSet(log_alpha_, config.init_alpha), adamWithRate<S>(config.alpha_lr)) {}
+      policy_net_(policy.params(), config.policy_lr),
+      q_net_(q.params(), config.q_lr, &q_target.params()),
+      alpha_net_(logAlphaSet(log_alpha_, config.init_alpha), config.alpha_lr) {}
 
 template <typename S>
 double SacTrainer<S>::alpha() const {
@@ -115,13 +108,13 @@ S SacTrainer<S>::temperatureLoss() {
 template <typename S>
 SacStats SacTrainer<S>::step(const ReplayBatch<S>& batch, Rng& rng) {
   stats_.q_loss = static_cast<double>(criticLoss(batch, rng));
-  q_adam_.step();
+  q_net_.step();
   stats_.actor_loss = static_cast<double>(actorLoss(batch, rng));
-  policy_adam_.step();
+  policy_net_.step();
   stats_.alpha_loss = static_cast<double>(temperatureLoss());
-  if (config_.autotune) alpha_adam_.step();
+  if (config_.autotune) alpha_net_.step();
   stats_.alpha = alpha();
-  q_target_->moveTowards(*q_, static_cast<S>(config_.polyak));
+  q_net_.updateTarget(static_cast<S>(config_.polyak));
   ++steps_;
   return stats_;
 }
@@ -138,9 +131,9 @@ void SacTrainer<S>::save(std::ostream& os) const {
   nn::saveParameters(q_->params(), os);
   nn::saveParameters(q_target_->params(), os);
   nn::saveParameters(log_alpha_, os);
-  policy_adam_.save(os);
-  q_adam_.save(os);
-  alpha_adam_.save(os);
+  policy_net_.saveOptimizer(os);
+  q_net_.saveOptimizer(os);
+  alpha_net_.saveOptimizer(os);
 }
 
 template <typename S>
@@ -153,9 +146,9 @@ void SacTrainer<S>::load(std::istream& is) {
   nn::loadParameters(q_->params(), is, "SAC trainer state (Q)");
   nn::loadParameters(q_target_->params(), is, "SAC trainer state (target Q)");
   nn::loadParameters(log_alpha_, is, "SAC trainer state (log alpha)");
-  policy_adam_.load(is);
-  q_adam_.load(is);
-  alpha_adam_.load(is);
+  policy_net_.loadOptimizer(is);
+  q_net_.loadOptimizer(is);
+  alpha_net_.loadOptimizer(is);
 }
 
 template class SacTrainer<float>;

@@ -14,7 +14,7 @@
 
 #include <iosfwd>
 
-#include "common/nn/adam.hpp"
+#include "common/nn/optimized_net.hpp"
 #include "learner/offline/twin_q.hpp"
 #include "learner/sac/off_policy_trainer.hpp"
 #include "learner/sac/replay_buffer.hpp"
@@ -58,7 +58,7 @@ class SacTrainer : public OffPolicyTrainer<S> {
   SacConfig config_;
   double target_entropy_;
   nn::ParameterSet<S> log_alpha_;
-  nn::Adam<S> policy_adam_, q_adam_, alpha_adam_;
+  nn::OptimizedNet<S> policy_net_, q_net_, alpha_net_;  // q_net_ moves q_target
   long long steps_ = 0;
   SacStats stats_;
 

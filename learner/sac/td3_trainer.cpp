@@ -12,15 +12,6 @@
 #include "common/model/td3_noise.hpp"
 
 namespace masa::sac {
-namespace {
-template <typename S>
-nn::AdamConfig<S> adamWithRate(double lr) {
-  nn::AdamConfig<S> c;
-  c.lr = static_cast<S>(lr);
-  return c;
-}
-}  // namespace
-
 template <typename S>
 Td3Trainer<S>::Td3Trainer(const sym::SymmetrySpec& spec, SacPolicy<S>& policy, offline::TwinQ<S>& q,
                           offline::TwinQ<S>& q_target, const SacConfig& config)
@@ -29,10 +20,10 @@ Td3Trainer<S>::Td3Trainer(const sym::SymmetrySpec& spec, SacPolicy<S>& policy, o
       q_(&q),
       q_target_(&q_target),
       config_(config),
-      policy_adam_(policy.params(), adamWithRate<S>(config.policy_lr)),
-      q_adam_(q.params(), adamWithRate<S>(config.q_lr)) {
+      policy_net_(policy.params(), config.policy_lr, &policy_target_.params()),
+      q_net_(q.params(), config.q_lr, &q_target.params()) {
   MASA_CHECK(config.td3_policy_delay >= 1, "TD3's policy delay must be at least 1");
-  policy_target_.params().values() = policy.params().values();
+  policy_net_.copyToTarget();
   stats_.entropy = std::numeric_limits<double>::quiet_NaN();
 }
 
@@ -97,14 +88,13 @@ S Td3Trainer<S>::actorLoss(const ReplayBatch<S>& batch) {
 template <typename S>
 SacStats Td3Trainer<S>::step(const ReplayBatch<S>& batch, Rng& rng) {
   stats_.q_loss = static_cast<double>(criticLoss(batch, rng));
-  q_adam_.step();
+  q_net_.step();
   ++steps_;
   if (steps_ % config_.td3_policy_delay == 0) {
     stats_.actor_loss = static_cast<double>(actorLoss(batch));
-    policy_adam_.step();
-    const S rate = static_cast<S>(config_.polyak);
-    q_target_->moveTowards(*q_, rate);
-    policy_target_.params().values() += rate * (policy_->params().values() - policy_target_.params().values());
+    policy_net_.step();
+    q_net_.updateTarget(static_cast<S>(config_.polyak));
+    policy_net_.updateTarget(static_cast<S>(config_.polyak));
   }
   return stats_;
 }
@@ -121,8 +111,8 @@ void Td3Trainer<S>::save(std::ostream& os) const {
   policy_target_.save(os);
   nn::saveParameters(q_->params(), os);
   nn::saveParameters(q_target_->params(), os);
-  policy_adam_.save(os);
-  q_adam_.save(os);
+  policy_net_.saveOptimizer(os);
+  q_net_.saveOptimizer(os);
 }
 
 template <typename S>
@@ -135,8 +125,8 @@ void Td3Trainer<S>::load(std::istream& is) {
   policy_target_.load(is, "TD3 trainer state (target policy)");
   nn::loadParameters(q_->params(), is, "TD3 trainer state (Q)");
   nn::loadParameters(q_target_->params(), is, "TD3 trainer state (target Q)");
-  policy_adam_.load(is);
-  q_adam_.load(is);
+  policy_net_.loadOptimizer(is);
+  q_net_.loadOptimizer(is);
 }
 
 template class Td3Trainer<float>;

@@ -14,7 +14,7 @@
 
 #include <iosfwd>
 
-#include "common/nn/adam.hpp"
+#include "common/nn/optimized_net.hpp"
 #include "learner/offline/twin_q.hpp"
 #include "learner/sac/off_policy_trainer.hpp"
 #include "common/config/sac_config.hpp"
@@ -49,7 +49,7 @@ class Td3Trainer : public OffPolicyTrainer<S> {
   offline::TwinQ<S>* q_;
   offline::TwinQ<S>* q_target_;
   SacConfig config_;
-  nn::Adam<S> policy_adam_, q_adam_;
+  nn::OptimizedNet<S> policy_net_, q_net_;  // with their targets policy_target_, q_target
   long long steps_ = 0;
   SacStats stats_;
 
