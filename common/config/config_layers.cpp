@@ -34,7 +34,9 @@ void mergeOpen(YAML::Node dst, const YAML::Node& src, const std::string& path, c
   }
 }
 
-std::string unknownKey(const YAML::Node& schema, const std::string& key) {
+// Names the schema's file too: when that file is damaged (cut short), the key is fine and the
+// schema is what is missing it.
+std::string unknownKey(const YAML::Node& schema, const std::string& key, const std::string& schema_file) {
   std::vector<std::string> known;
   std::string listed;
   for (const auto& s : schema) {
@@ -43,6 +45,7 @@ std::string unknownKey(const YAML::Node& schema, const std::string& key) {
   }
   std::string what = "unknown key (known here: " + listed + ")";
   if (const std::string near = nearestName(key, known); !near.empty()) what += "; did you mean '" + near + "'?";
+  if (!schema_file.empty()) what += " (the keys are those of " + schema_file + ")";
   return what;
 }
 
@@ -98,7 +101,7 @@ void ConfigLayers::overlayAt(YAML::Node dst, const YAML::Node& src, const YAML::
       continue;
     }
     const YAML::Node expected = schema[key];
-    if (!expected) throw ConfigError(file, full, unknownKey(schema, key));
+    if (!expected) throw ConfigError(file, full, unknownKey(schema, key, schema_file_));
     if (expected.IsMap()) {
       overlayAt(dst[key], value, expected, full, file);
     } else {
