@@ -385,8 +385,13 @@ void Learner::report() {
                       statsMessage(report_, columns_, run_id_, dropStats(), c.envs_stale, c.envs_overflow));
   appendMetricsRow((fs::path(dir_) / "metrics.csv").string(), report_, columns_);
   if (!curve_)
-    curve_ = std::make_unique<LearningCurve>(dir_, rc_.task + " / " + model::methodName(rc_.method), columns_.term_names,
-                                             has_success_);
+    curve_ = off_policy_
+                 ? std::make_unique<LearningCurve>(
+                       dir_, LearningCurve::Script{learningCurveScript(rc_.task + " / " + model::methodName(rc_.method) +
+                                                                           " (off-policy)",
+                                                                       columns_.term_names, has_success_, false)})
+                 : std::make_unique<LearningCurve>(dir_, rc_.task + " / " + model::methodName(rc_.method),
+                                                   columns_.term_names, has_success_);
   if (rc_.runner.plot_every > 0 && updates_ % rc_.runner.plot_every == 0) curve_->renderAsync();
   if (opt_.verbose) printProgress(report_, columns_, max_updates_, update_interval_s_, rc_.runner.eval_episodes);
 }

@@ -60,7 +60,7 @@ std::string curveScriptFooter() {
 }
 
 std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names,
-                                bool has_success) {
+                                bool has_success, bool ppo_panels) {
   std::ostringstream g;
   std::string terms;
   for (const auto& t : term_names) terms += (terms.empty() ? "" : " ") + t;
@@ -90,13 +90,18 @@ std::string learningCurveScript(const std::string& title, const std::vector<std:
   g << "set key font \",10\"\n"
        "set title \"losses\"\n"
        "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"actor_loss\" pt 7 title \"actor\", \\\n"
-       "     \"\" using (column(\"env_steps\")/1e6):\"critic_loss\" pt 7 title \"critic\"\n"
-       "set title \"KL and learning rate\"\n"
+       "     \"\" using (column(\"env_steps\")/1e6):\"critic_loss\" pt 7 title \"critic\"\n";
+  if (!ppo_panels)  // TD3's entropy is NaN: the critic loss keeps the panel drawable
+    g << "set title \"policy entropy and twin-Q loss\"\n"
+         "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"entropy\" pt 7 title \"entropy (SAC)\", \\\n"
+         "     \"\" using (column(\"env_steps\")/1e6):\"critic_loss\" pt 7 title \"twin-Q loss\"\n";
+  else
+    g << "set title \"KL and learning rate\"\n"
        "set logscale y\n"
        "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"kl\" pt 7 title \"KL(old||new)\", \\\n"
        "     \"\" using (column(\"env_steps\")/1e6):\"lr\" pt 7 title \"learning rate\"\n"
-       "unset logscale y\n"
-       "set title \"throughput\"\n"
+       "unset logscale y\n";
+  g << "set title \"throughput\"\n"
        "plot \"metrics.csv\" using (column(\"env_steps\")/1e6):\"fps\" pt 7 title \"env steps / s\"\n"
     << curveScriptFooter();
   return g.str();

@@ -34,7 +34,9 @@ YAML::Node ConfigSection::node(const std::string& key) const {
   for (std::string part; std::getline(ss, part, '.');) {
     if (!n.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
     const YAML::Node next = n[part];
-    if (!next.IsDefined()) return next;
+    // A missing key: an undefined node, never the zombie yaml-cpp returns (reading it throws
+    // InvalidNode, which names no file).
+    if (!next.IsDefined()) return YAML::Node(YAML::NodeType::Undefined);
     n.reset(next);
   }
   return n;

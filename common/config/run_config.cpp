@@ -64,6 +64,9 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
                             const YAML::Node& base, const std::string& base_file) {
   const std::string defaults_file = configs_dir + "/defaults.yaml";
   const YAML::Node schema = loadYamlFile(defaults_file, "(file)");
+  // Read below before any layer: a damaged schema is named here, not by yaml-cpp's InvalidNode.
+  if (!schema.IsMap() || !schema["task"])
+    throw ConfigError(defaults_file, "task", "the schema has no task key (is the file damaged or cut short?)");
   RunConfig rc;
   rc.defaults_file = defaults_file;
   ConfigLayers layers(schema, defaults_file, kRunRules);

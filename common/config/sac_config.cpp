@@ -14,6 +14,7 @@ SacConfig readSacConfig(const config::RunConfig& rc) {
   c.batch_size = r.atLeast("batch_size", 1);
   c.learning_starts = r.atLeast("learning_starts", 1LL);
   c.updates_per_step = r.positive("updates_per_step");
+  c.threads = r.atLeast("threads", 1);
   c.n_step = r.atLeast("n_step", 1);
   c.discount = r.inRange("discount", 0.0, 1.0);
   c.polyak = r.inRange("polyak", 0.0, 1.0, true);

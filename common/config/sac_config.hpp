@@ -17,6 +17,7 @@ struct SacConfig {
   int batch_size = 256;
   long long learning_starts = 5000;
   double updates_per_step = 1;  // may be fractional: gradient steps owed = floor(ratio x steps past learning_starts)
+  int threads = 1;  // learner: off_policy: OpenMP threads of the gradient steps
   int n_step = 1;
   double discount = 0.99;
   double polyak = 0.005;

@@ -1,5 +1,7 @@
 #include "learner/sac/off_policy_rule.hpp"
 
+#include <omp.h>
+
 #include <cmath>
 #include <istream>
 #include <ostream>
@@ -60,6 +62,9 @@ ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, Rng& rng) {
   if (!fitted_) return out;
   SacStats sums;
   int n = 0;
+  // The gradient steps on sac.threads threads (restored after): see configs/defaults.yaml.
+  const int prev_threads = omp_get_max_threads();
+  omp_set_num_threads(sc_.threads);
   for (const long long owed = gradientStepsOwed(sc_, received_ - sc_.learning_starts + 1); trainer_->steps() < owed; ++n) {
     replay_.sample(sc_.batch_size, sc_.n_step, sc_.discount, rng, batch_);
     const SacStats s = trainer_->step(batch_, rng);
@@ -71,6 +76,7 @@ ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, Rng& rng) {
     sums.mean_q += s.mean_q;
     sums.entropy += s.entropy;
   }
+  omp_set_num_threads(prev_threads);
   round_steps_ = n;
   if (n == 0) return out;
   for (double* v : {&sums.q_loss, &sums.actor_loss, &sums.alpha_loss, &sums.symmetry_loss, &sums.alpha, &sums.mean_q,

@@ -4,7 +4,8 @@
 # multicast (udpm, ttl=0). The actors stream their rollouts, the learner keeps them in its replay
 # buffer and takes SAC's gradient steps. Passes when
 #  - both actors' data reached the learner and every round's gradient steps are the ones owed
-#    (floor(updates_per_step x transitions past learning_starts), minus the steps of the rounds before);
+#    (floor(updates_per_step x transitions past learning_starts), minus the steps of the rounds before;
+#    a round short of a lost chunk's environments brings fewer transitions and is owed fewer);
 #  - it learned: the mean training return of the last 8 rounds is at least twice that of rounds 5-12
 #    (the first rounds of the policy, after the uniform warm-up) and above 20 (uniformly random
 #    actions earn 6-13 here);
@@ -32,9 +33,9 @@ for a in 0 1; do grep -q "actor $a joined" "$work/train.log" "$run"/*.log 2> /de
 
 # Each round's gradient steps (off_policy.csv) are the ones its data owed, and the policy lag stays
 # within ppo.max_policy_lag (0: every round's data acted with the newest parameters).
-awk -F, -v starts=$starts -v ups=$ups -v per=$((2 * envs * horizon)) '
+awk -F, -v starts=$starts -v ups=$ups '
   NR == 1 { for (c = 1; c <= NF; c++) col[$c] = c; next }
-  { n = NR - 1; got = n * per; owed = got >= starts ? int(ups * (got - starts + 1) + 1e-9) : 0
+  { n = NR - 1; got = $col["env_steps"]; owed = got >= starts ? int(ups * (got - starts + 1) + 1e-9) : 0
     if ($col["gradient_steps"] != owed - before) { printf "FAIL: round %d took %s gradient steps, owed %d\n", n, $col["gradient_steps"], owed - before; exit }
     if ($col["policy_lag_max"] != 0) { printf "FAIL: round %d has policy lag %s\n", n, $col["policy_lag_max"]; exit }
     before = owed }' "$run/off_policy.csv" > "$work/verdict.txt"
@@ -45,5 +46,10 @@ awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) col[$c] = c; next }
         printf "training return: rounds 5-12 %.1f, last 8 %.1f\n", early, late
         if (!(late >= 2 * early && late > 20)) print "FAIL: it did not learn" }' "$run/metrics.csv" | tee -a "$work/verdict.txt"
 grep -q FAIL "$work/verdict.txt" && fail "$(cat "$work/verdict.txt")"
+# The learning curve is drawn (its panels are the off-policy ones: gnuplot stopped on PPO's KL panel).
+if command -v gnuplot > /dev/null; then
+  [ -s "$run/learning_curve.png" ] || fail "no learning_curve.png: $(cat "$run/learning_curve.log" 2> /dev/null | head -5)"
+  ! grep -q "undefined" "$run/learning_curve.log" 2> /dev/null || fail "gnuplot: $(head -5 "$run/learning_curve.log")"
+fi
 "$build/tools/masa_eval" "$run" --episodes 2 > "$work/eval.log" 2>&1 || fail "masa_eval refused the run's policy.bin: $(tail -n 3 "$work/eval.log")"
 echo "PASS: an off-policy run of 2 actors over LCM took every owed gradient step and learned ($(grep "^training return" "$work/verdict.txt" | sed 's/training return: //')); masa_eval read its policy"

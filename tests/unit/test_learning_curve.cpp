@@ -68,6 +68,30 @@ TEST(LearningCurve, RendersAPngFromMetricsWithEveryRewardTerm) {
 
 // Issue #31: the env-step ticks ran together ("1e+062e+06..."), legends lay over the curves, and a
 // task without success (the A1) had a success axis.
+// learner: off_policy writes 0 for kl and lr (and TD3 NaN for the entropy): PPO's log-scale KL panel
+// has no point, gnuplot stopped there and no picture came; the off-policy panels draw.
+TEST(LearningCurve, AnOffPolicyRunWithZeroKlAndLearningRateIsDrawnWithItsOwnPanels) {
+  if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
+  const fs::path dir = freshDir("off_policy");
+  {
+    std::ofstream f(dir / "metrics.csv");
+    f << "update,env_steps,wall_time_s,fps,return,length,success,term_alive,actor_loss,critic_loss,entropy,"
+         "bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped_chunks,dropped_envs,"
+         "eval_return,eval_length,eval_success\n";
+    for (int i = 0; i < 5; ++i)
+      f << i + 1 << ',' << (i + 1) * 512 << ",1,500," << 5 + i << ",30,-1,1," << -i << ',' << 2.0 / (i + 1)
+        << ",nan,0,0,0,0,0,0,0,0,0,nan,nan,nan\n";
+  }
+  {
+    LearningCurve ppo(dir.string(), "a1_beam / masa", {"alive"}, false);
+    EXPECT_FALSE(ppo.renderAndWait()) << "PPO's KL panel cannot be drawn from zeros: the case this guards";
+  }
+  LearningCurve off(dir.string(), LearningCurve::Script{learningCurveScript("a1_beam / masa", {"alive"}, false, false)});
+  ASSERT_TRUE(off.renderAndWait()) << "gnuplot log: " << (dir / "learning_curve.log");
+  EXPECT_TRUE(isPng(off.pngPath()));
+  fs::remove_all(dir);
+}
+
 TEST(LearningCurve, StepsInMillionsLegendsBelowTheDataAndASuccessAxisOnlyWhereTheTaskHasOne) {
   const std::string with = learningCurveScript("trifinger_lift / masa", {"alive"}, true);
   const std::string without = learningCurveScript("a1_beam / masa", {"alive"}, false);
