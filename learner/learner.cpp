@@ -73,10 +73,10 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
       opt_(options),
       dir_(options.run_dir),
       rng_(rc.seed),
-      round_(rc.runner.loss_grace_s),
-      delivery_(rc.runner.repeat_unacknowledged_s, rc.runner.republish_every_s, kActorLiveS),
       ranks_(options.ranks ? options.ranks : &cluster::soloCommunicator()),
-      rank_envs_(rc.ppo.num_envs / ranks_->size()) {
+      rank_envs_(rc.ppo.num_envs / ranks_->size()),
+      round_(rc.runner.loss_grace_s),
+      delivery_(rc.runner.repeat_unacknowledged_s, rc.runner.republish_every_s, kActorLiveS) {
   MASA_CHECK(!dir_.empty(), "learner: no run directory");
   MASA_CHECK(rc.ppo.num_envs % ranks_->size() == 0, "ppo.num_envs " << rc.ppo.num_envs << " must divide among the "
                                                                      << ranks_->size() << " learner ranks");
@@ -325,9 +325,12 @@ void Learner::update() {
     lag_mean += static_cast<double>(updates_ - v) / static_cast<double>(origin_.env_version.size());
     lag_max = std::max(lag_max, updates_ - v);
   }
-  if (off_policy_) report_.ppo = off_policy_->learn(buffer_->data(), rng_);
-  else optimizePpo();
-
+  if (off_policy_) {
+    report_.ppo = off_policy_->learn(buffer_->data(), rng_);
+    report_.algorithm_figures = offPolicyProgressFigures(off_policy_->roundFigures());
+  } else {
+    optimizePpo();
+  }
 
   const auto now = std::chrono::steady_clock::now();
   const double dt = std::chrono::duration<double>(now - last_update_).count();

@@ -104,6 +104,26 @@ void appendMetricsRow(const std::string& path, const UpdateReport& report, const
   f << '\n';
 }
 
+std::string offPolicyProgressFigures(const std::vector<std::pair<std::string, double>>& figures) {
+  auto figure = [&](const char* name) {
+    for (const auto& [n, v] : figures)
+      if (n == name) return v;
+    return std::nan("");
+  };
+  char line[200];
+  if (figure("warming_up") > 0) {
+    std::snprintf(line, sizeof(line), "warming up: uniform random actions, replay %.0f", figure("replay_size"));
+  } else {
+    // TD3 has no temperature: alpha 0 and entropy NaN (off_policy_trainer.hpp).
+    const double alpha = figure("alpha"), entropy = figure("entropy");
+    char temperature[64] = "";
+    if (!std::isnan(entropy)) std::snprintf(temperature, sizeof(temperature), "  alpha %.4f  entropy %.2f", alpha, entropy);
+    std::snprintf(line, sizeof(line), "grad steps %.0f  q %.4f  actor %.4f%s  mean Q %.2f", figure("gradient_steps"),
+                  figure("q_loss"), figure("actor_loss"), temperature, figure("mean_q"));
+  }
+  return line;
+}
+
 void printProgress(const UpdateReport& report, const ReportColumns& columns, int64_t max_updates,
                    double update_interval_s, int eval_episodes) {
   const int64_t done = report.update;  // updates done, this one included
@@ -116,12 +136,15 @@ void printProgress(const UpdateReport& report, const ReportColumns& columns, int
   if (max_updates > 0) std::snprintf(total, sizeof(total), "/%lld", static_cast<long long>(max_updates));
   char success[32] = "";  // only for tasks with a success notion
   if (report.success_rate >= 0) std::snprintf(success, sizeof(success), "  success %.2f", report.success_rate);
-  std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f%s  kl %.5f  lr %.2e  "
-              "actor %.4f  critic %.4f  dropped %lld chunks %lld envs%s\n",
+  char ppo[160] = "";
+  if (report.algorithm_figures.empty())
+    std::snprintf(ppo, sizeof(ppo), "kl %.5f  lr %.2e  actor %.4f  critic %.4f", report.ppo.kl, report.ppo.lr,
+                  report.ppo.actor_loss, report.ppo.critic_loss);
+  std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f%s  %s  dropped %lld chunks %lld envs%s\n",
               static_cast<long long>(done), total, static_cast<long long>(report.env_steps), report.fps,
-              report.mean_return, report.mean_length, success, report.ppo.kl, report.ppo.lr, report.ppo.actor_loss,
-              report.ppo.critic_loss, static_cast<long long>(report.dropped_chunks),
-              static_cast<long long>(report.dropped_envs), eta);
+              report.mean_return, report.mean_length, success,
+              report.algorithm_figures.empty() ? ppo : report.algorithm_figures.c_str(),
+              static_cast<long long>(report.dropped_chunks), static_cast<long long>(report.dropped_envs), eta);
   if (!std::isnan(report.eval_return)) {
     std::printf("  eval (policy mean, %d episodes): return %.3f  len %.1f", eval_episodes, report.eval_return,
                 report.eval_length);

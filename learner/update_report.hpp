@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/cluster/communicator.hpp"
@@ -33,7 +34,14 @@ struct UpdateReport {
   // The policy mean's evaluation (runner.eval_every): NaN in updates without one.
   double eval_return = std::nan(""), eval_length = std::nan(""), eval_success = std::nan("");
   std::vector<double> eval_progress;  // the task's progress figures (Task::progressNames)
+  // The progress line's figures of an algorithm other than PPO, in place of PPO's kl, lr and
+  // losses (empty for PPO): learner: off_policy's offPolicyProgressFigures().
+  std::string algorithm_figures;
 };
+
+// An off-policy round's part of the progress line: its gradient steps, twin-Q loss, temperature,
+// entropy and mean Q, or that it still acts at random (the run's off_policy.csv has every figure).
+std::string offPolicyProgressFigures(const std::vector<std::pair<std::string, double>>& figures);
 
 // Episode statistics of a batch: mean return, length and reward terms, and the success rate over
 // the episodes that have a success measure (-1 when none has). NaN means when no episode ended.

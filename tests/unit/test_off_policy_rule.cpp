@@ -12,6 +12,7 @@
 #include "actors/squashed_behaviour.hpp"
 #include "common/config/run_config.hpp"
 #include "learner/sac/off_policy_rule.hpp"
+#include "learner/update_report.hpp"
 
 namespace masa::sac {
 namespace {
@@ -149,6 +150,33 @@ TEST(OffPolicyRule, ASavedAndReloadedStateTakesTheSameNextRoundBitForBit) {
   EXPECT_EQ(ma.obs_std, mb.obs_std);
   std::stringstream cut(state.str().substr(0, 40));
   EXPECT_THROW(b.load(cut, "cut"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace masa::sac
+
+namespace masa::sac {
+namespace {
+
+// The progress line of an off-policy round shows its own figures, by the names the rule reports
+// (a renamed column would print "nan"), not PPO's kl and lr (always 0 here); a TD3 round has no
+// temperature to show.
+TEST(OffPolicyRule, TheProgressLineShowsTheRoundsGradientStepsTemperatureAndEntropy) {
+  for (const char* algorithm : {"sac", "td3"}) {
+    const auto rc = smallRun({"sac.learning_starts=8", std::string("sac.algorithm=") + algorithm});
+    Rng rng(4);
+    OffPolicyRule rule(rc, rng);
+    const auto b = batchOf(2, 3, rule.replay().obsDim(), rule.replay().actDim());
+    rule.learn(b, rng);
+    EXPECT_EQ(learner::offPolicyProgressFigures(rule.roundFigures()), "warming up: uniform random actions, replay 6");
+    rule.learn(b, rng);  // floor(1 x (12 - 8 + 1)) = 5 steps
+    const std::string line = learner::offPolicyProgressFigures(rule.roundFigures());
+    EXPECT_EQ(line.rfind("grad steps 5  q ", 0), 0u) << line;
+    EXPECT_EQ(line.find("nan"), std::string::npos) << line;
+    EXPECT_NE(line.find("mean Q "), std::string::npos) << line;
+    EXPECT_EQ(line.find("alpha ") != std::string::npos, std::string(algorithm) == "sac") << line;
+    EXPECT_EQ(line.find("entropy ") != std::string::npos, std::string(algorithm) == "sac") << line;
+  }
 }
 
 }  // namespace
