@@ -318,6 +318,12 @@ void Learner::optimizePpo() {
 }
 
 void Learner::update() {
+  // The learner reads no message while it updates: that time is not the actors' silence.
+  struct ExcuseBusyTime {
+    SilenceWatch& watch;
+    std::chrono::steady_clock::time_point from = std::chrono::steady_clock::now();
+    ~ExcuseBusyTime() { watch.learnerWasBusy(std::chrono::steady_clock::now() - from); }
+  } excuse{*silence_};
   // How far behind the parameters being trained the batch's environments acted, in updates.
   double lag_mean = 0;
   int64_t lag_max = 0;

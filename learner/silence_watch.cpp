@@ -20,6 +20,11 @@ void SilenceWatch::heard(int actor_id, Clock::time_point now) {
   dropped_at_last_data_ = -1;
 }
 
+void SilenceWatch::learnerWasBusy(Clock::duration d) {
+  last_data_ += d;
+  last_warning_ += d;
+}
+
 double SilenceWatch::silentFor(Clock::time_point now) const { return seconds(now - last_data_); }
 
 std::optional<std::string> SilenceWatch::check(Clock::time_point now, int64_t update, int64_t dropped_chunks) {

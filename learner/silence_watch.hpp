@@ -27,6 +27,11 @@ class SilenceWatch {
   // into the text: chunks dropped during the silence point at a mismatched sender.
   std::optional<std::string> check(Clock::time_point now, int64_t update, int64_t dropped_chunks);
 
+  // The learner was busy for `d` (an update, its evaluation, its checkpoint) and read no message
+  // meanwhile: that time is not the actors' silence. An off-policy round's gradient steps take
+  // tens of seconds, and the learner said "no rollout data" after each one.
+  void learnerWasBusy(Clock::duration d);
+
   // Seconds since the last accepted chunk (or since the start, when none came yet).
   double silentFor(Clock::time_point now) const;
 

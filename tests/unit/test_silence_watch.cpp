@@ -56,3 +56,19 @@ TEST(SilenceWatch, SilentForCountsFromTheStartOrTheLastChunk) {
   w.check(t0 + seconds(140), 2, 0);  // a warning does not reset it
   EXPECT_DOUBLE_EQ(w.silentFor(t0 + seconds(140)), 130.0);
 }
+
+// The time the learner spends updating (an off-policy round's gradient steps: tens of seconds) is
+// not silence of the actors: before the fix the learner said "no rollout data for 50 s" after
+// every such round of a healthy masa_train run.
+TEST(SilenceWatch, TheLearnersOwnBusyTimeIsNotSilence) {
+  const auto t0 = SilenceWatch::Clock::time_point{};
+  SilenceWatch w(30.0, t0);
+  w.heard(0, t0 + seconds(1));
+  w.learnerWasBusy(seconds(45));  // an update from t0 + 1 s to t0 + 46 s
+  EXPECT_FALSE(w.check(t0 + seconds(46), 3, 0));
+  EXPECT_DOUBLE_EQ(w.silentFor(t0 + seconds(50)), 4.0);
+  // Real silence after it still counts.
+  const auto said = w.check(t0 + seconds(77), 3, 0);
+  ASSERT_TRUE(said);
+  EXPECT_NE(said->find("no rollout data for 31 s"), std::string::npos) << *said;
+}
