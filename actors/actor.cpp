@@ -50,7 +50,7 @@ void singleThreaded(F&& f) {
 
 }  // namespace
 
-Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::Transport* transport)
+Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::MessageBus* transport)
     : config_(config),
       options_(std::move(options)),
       num_envs_(options_.num_envs),
@@ -116,7 +116,8 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::T
     owned_transport_ = makeTransport(options_.url.empty() ? transport::loopbackUrl() : options_.url);
     transport_ = owned_transport_.get();
   }
-  if (!options_.rollout_url.empty() && options_.rollout_url != transport_->url())
+  const auto* lcm = dynamic_cast<const transport::Transport*>(transport_);  // null for an in-process bus
+  if (!options_.rollout_url.empty() && (!lcm || options_.rollout_url != lcm->url()))
     rollout_transport_ = makeTransport(options_.rollout_url);
   char host[256] = {};
   if (gethostname(host, sizeof host - 1) == 0) hostname_ = host;

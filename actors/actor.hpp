@@ -30,6 +30,7 @@
 #include "common/rollout/rollout.hpp"
 #include "actors/rollout_chunker.hpp"
 #include "actors/squashed_behaviour.hpp"
+#include "common/transport/message_bus.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
@@ -99,9 +100,9 @@ struct ActorOptions {
 class Actor {
  public:
   // Throws std::runtime_error / ConfigError on a bad configuration. With `transport` given (memq
-  // tests share one in-process LCM), it is used instead of opening options.url; it must outlive
-  // the actor.
-  Actor(const config::RunConfig& config, ActorOptions options, transport::Transport* transport = nullptr);
+  // tests share one in-process LCM; masa_train a transport::LocalBus), it is used instead of
+  // opening options.url; it must outlive the actor.
+  Actor(const config::RunConfig& config, ActorOptions options, transport::MessageBus* transport = nullptr);
   ~Actor();
   Actor(const Actor&) = delete;
   Actor& operator=(const Actor&) = delete;
@@ -123,7 +124,7 @@ class Actor {
   int64_t chunksPublished() const { return chunks_published_; }
   int64_t chunksDropped() const { return chunks_dropped_; }  // by drop_chunks_percent
   int64_t paramsRejected() const { return params_rejected_; }
-  const transport::Transport& transport() const { return *transport_; }
+  const transport::MessageBus& transport() const { return *transport_; }
   const rollout::Rollout& lastRollout() const { return rollout_; }
   int numEnvs() const { return num_envs_; }
   model::ActorCritic<float>& model() { return *model_; }
@@ -153,10 +154,10 @@ class Actor {
   ActorOptions options_;
   int num_envs_;
   int horizon_;
-  std::unique_ptr<transport::Transport> owned_transport_;
-  transport::Transport* transport_;
-  std::unique_ptr<transport::Transport> rollout_transport_;  // options.rollout_url's, when it differs
-  transport::Transport& sender() { return rollout_transport_ ? *rollout_transport_ : *transport_; }
+  std::unique_ptr<transport::MessageBus> owned_transport_;
+  transport::MessageBus* transport_;
+  std::unique_ptr<transport::MessageBus> rollout_transport_;  // options.rollout_url's, when it differs
+  transport::MessageBus& sender() { return rollout_transport_ ? *rollout_transport_ : *transport_; }
   std::unique_ptr<task::TaskFactory> factory_;
   std::vector<std::unique_ptr<task::Task>> envs_;
   std::vector<Rng> rngs_;

@@ -121,9 +121,19 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   assembler_->setLearnerVersion(updates_);
 
   const std::string intake_url = opt_.rollout_url.empty() ? opt_.url : opt_.rollout_url;
-  transport_ = makeTransport(intake_url);
-  if (isLeadRank() && intake_url != opt_.url) policy_transport_ = makeTransport(opt_.url);
-  transport_->subscribeRaw(transport::kRolloutChannel, [this](const void* data, int size) { onChunk(data, size); });
+  if (opt_.bus) {
+    MASA_CHECK(ranks_->size() == 1, "learner: an in-process bus serves one learner rank (" << ranks_->size() << " given)");
+    transport_ = opt_.bus;
+    // Chunks as the actor made them, judged by the same assembler, without encoding.
+    transport_->subscribe<masa::lcmt_rollout_chunk>(
+        transport::kRolloutChannel, [this](const masa::lcmt_rollout_chunk& m) { onChunk(assembler_->accept(m)); });
+  } else {
+    owned_transport_ = makeTransport(intake_url);
+    transport_ = owned_transport_.get();
+    if (isLeadRank() && intake_url != opt_.url) policy_transport_ = makeTransport(opt_.url);
+    transport_->subscribeRaw(transport::kRolloutChannel,
+                             [this](const void* data, int size) { onChunk(assembler_->acceptEncoded(data, size)); });
+  }
   // Actors acknowledge parameters in their heartbeats, which they send on the parameters' URL:
   // rank 0 hears every actor of a data-parallel job there, not only those that feed its own URL.
   if (isLeadRank())
@@ -191,8 +201,7 @@ int64_t Learner::droppedEnvs() const {
   return collector_ ? collector_->stats().envs_stale + collector_->stats().envs_overflow : 0;
 }
 
-void Learner::onChunk(const void* data, int size) {
-  const Verdict v = assembler_->acceptEncoded(data, size);
+void Learner::onChunk(const Verdict& v) {
   if (!v) return;  // counted by the assembler
   const auto& m = v.chunk->msg();
   const auto now = std::chrono::steady_clock::now();

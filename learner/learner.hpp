@@ -26,6 +26,7 @@
 #include "common/model/actor_critic.hpp"
 #include "common/nn/adam.hpp"
 #include "common/sim/registry.hpp"
+#include "common/transport/message_bus.hpp"
 #include "common/transport/transport.hpp"
 #include "learner/intake/batch_collector.hpp"
 #include "learner/intake/rollout_assembler.hpp"
@@ -65,6 +66,10 @@ struct LearnerOptions {
   // run config and the learner's seeded generator; masa_learner and masa_train pass
   // learner/sac's. Unset: such a run is refused.
   std::function<std::unique_ptr<OffPolicyLearning>(const config::RunConfig&, Rng&)> make_off_policy;
+  // In-process (masa_train): every channel on this bus (a transport::LocalBus: typed messages
+  // handed over without encoding), owned by the caller; url, rollout_url and the keys are unused.
+  // Null: the learner makes its LCM transports from url and rollout_url.
+  transport::MessageBus* bus = nullptr;
 };
 
 class Learner {
@@ -94,8 +99,8 @@ class Learner {
   bool renderLearningCurve();
 
   // The intake's transport (rollouts); rank 0's parameters and stats go out on publisher().
-  transport::Transport& transport() { return *transport_; }
-  transport::Transport& publisher() { return policy_transport_ ? *policy_transport_ : *transport_; }
+  transport::MessageBus& transport() { return *transport_; }
+  transport::MessageBus& publisher() { return policy_transport_ ? *policy_transport_ : *transport_; }
   bool isLeadRank() const { return ranks_->rank() == 0; }
   int64_t runId() const { return run_id_; }
   // Updates done (resumed ones included). The policy version is the same count: the number of
@@ -123,7 +128,8 @@ class Learner {
 
  private:
   std::unique_ptr<transport::Transport> makeTransport(const std::string& url) const;
-  void onChunk(const void* data, int size);
+  // A chunk the assembler has judged (from bytes, or a message handed over in-process).
+  void onChunk(const Verdict& v);
   void onHeartbeat(const masa::lcmt_actor_heartbeat& m);
   // How long step() may wait for traffic: at most timeout_ms, less when a short batch or a repeat
   // of the parameters comes due sooner.
@@ -165,8 +171,9 @@ class Learner {
   bool entered_silent_ = false;     // this rank entered the barrier because it heard nothing for too long
   int silent_ranks_at_stop_ = 0;
   const std::atomic<bool>* stop_ = nullptr;  // run()'s
-  std::unique_ptr<transport::Transport> transport_;
-  std::unique_ptr<transport::Transport> policy_transport_;  // rank 0, when the rollouts come on another URL
+  std::unique_ptr<transport::MessageBus> owned_transport_;  // made from url / rollout_url (LCM)
+  transport::MessageBus* transport_ = nullptr;              // the intake's: owned_transport_ or options.bus
+  std::unique_ptr<transport::MessageBus> policy_transport_;  // rank 0, when the rollouts come on another URL
   std::unique_ptr<RolloutAssembler> assembler_;  // made once the run id is known
   std::unique_ptr<SilenceWatch> silence_;
   // Made on the first accepted chunk: the reward term names come from the actors' task.

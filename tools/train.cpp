@@ -1,4 +1,5 @@
-// masa_train: the learner and one actor in one process, over an in-process memq:// LCM.
+// masa_train: the learner and one actor in one process, over an in-process bus (LocalBus: messages
+// handed over as they are, never encoded).
 //
 // The same Learner and Actor classes as masa_learner / masa_actor, taking turns: the actor collects
 // one rollout of all ppo.num_envs environments, the learner updates on it, the actor picks up the
@@ -13,6 +14,8 @@
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +24,8 @@
 #include "common/core/build_info.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
+#include "common/transport/local_bus.hpp"
+#include "common/transport/transport.hpp"
 #include "learner/learner.hpp"
 #include "learner/sac/off_policy_rule.hpp"
 
@@ -39,6 +44,7 @@ int main(int argc, char** argv) {
   std::string recipe, resume;
   int threads = 1;
   bool quiet = false;
+  std::string bus_kind = "local";
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set task=a1_beam");
   app.add_option("--configs", configs, "configs directory")->capture_default_str();
   app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_inprocess)");
@@ -49,6 +55,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1024));
   app.add_option("--resume", resume, "go on with the run in this directory (its config.yaml and checkpoint.bin)");
   app.add_flag("--quiet", quiet, "no progress line per update");
+  app.add_option("--bus", bus_kind,
+                 "local: messages handed over as they are; memq: through LCM's in-process provider, each "
+                 "message encoded, guarded and decoded (as before 2026-12-04; the same run, slower)")
+      ->check(CLI::IsMember({"local", "memq"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   std::signal(SIGINT, onSignal);
@@ -65,8 +76,11 @@ int main(int argc, char** argv) {
     if (run_dir.empty())
       run_dir = "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" + std::to_string(rc.seed) +
                 "_inprocess";
+    std::unique_ptr<masa::transport::MessageBus> bus;
+    if (bus_kind == "memq") bus = std::make_unique<masa::transport::Transport>("memq://", std::nullopt);
+    else bus = std::make_unique<masa::transport::LocalBus>();
     masa::learner::LearnerOptions lo;
-    lo.url = "memq://";
+    lo.bus = bus.get();
     lo.run_dir = run_dir;
     lo.run_id = 1;
     lo.verbose = !quiet;
@@ -82,7 +96,7 @@ int main(int argc, char** argv) {
     ao.incarnation = 1;  // bit-identical chunks from run to run
     ao.heartbeat_interval_s = 1e9;  // nobody listens
     ao.stop = &g_stop;
-    masa::actor::Actor actor(rc, ao, &learner.transport());
+    masa::actor::Actor actor(rc, ao, bus.get());
     std::fprintf(stderr, "masa_train: %s / %s, %d envs x %d steps per update, %lld updates, run dir %s\n",
                  rc.task.c_str(), masa::model::methodName(rc.method).c_str(), rc.ppo.num_envs, rc.ppo.horizon,
                  static_cast<long long>(updates), learner.runDir().c_str());

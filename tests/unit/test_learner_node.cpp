@@ -87,7 +87,7 @@ struct FakeActor {
 
   // Publishes the rollout's chunks as actor 0's rollout `seq`, acted with `version`.
   // Chunks `keep` says no to are lost on the way.
-  int send(transport::Transport& t, int64_t run_id, int64_t seq, int64_t version,
+  int send(transport::MessageBus& t, int64_t run_id, int64_t seq, int64_t version,
            const std::function<bool(int chunk_index)>& keep = {}) {
     const auto chunks = chunker.split(rollout, {run_id, 0, seq, version});
     for (const auto& c : chunks)
@@ -236,7 +236,7 @@ TEST(LearnerNode, WithARunKeyChunksSignedWithAnotherKeyAreCountedUnauthenticated
     std::vector<uint8_t> bytes(c.getEncodedSize() + transport::kAuthTrailerBytes);
     const int size = c.encode(bytes.data(), 0, c.getEncodedSize());
     other.seal(transport::kRolloutChannel, bytes.data(), size, bytes.data() + size);
-    learner.transport().publishWire(transport::kRolloutChannel, bytes.data(), static_cast<int>(bytes.size()));
+    dynamic_cast<transport::Transport&>(learner.transport()).publishWire(transport::kRolloutChannel, bytes.data(), static_cast<int>(bytes.size()));
   }
   const int forged = static_cast<int>(chunks.size());
   EXPECT_FALSE(stepUntilUpdate(learner, 50));

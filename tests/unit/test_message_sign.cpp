@@ -440,7 +440,7 @@ TEST(MessageSignLearner, ARolloutChunkSignedByActorOneClaimingActorZeroIsRefused
   SignedRun run(2, "claims");
   const fs::path dir = run.dir / "learner";
   learner::Learner learner(rc, learnerOptions(dir, run));
-  auto& bus = learner.transport();
+  auto& bus = dynamic_cast<Transport&>(learner.transport());  // bytes on the wire, as a forger sends them
   const auto chunks = batchOf(rc, 0, 0);
   ASSERT_GT(chunks.size(), 1u);
   // Actor 1's key on a whole batch that names actor 0.
@@ -467,7 +467,7 @@ TEST(MessageSignLearner, AReplayedChunkIsRefusedAsReplayedAndANonActorsChunkIsNo
   const auto rc = smallConfig();
   SignedRun run(1, "learner_replay");
   learner::Learner learner(rc, learnerOptions(run.dir / "learner", run));
-  auto& bus = learner.transport();
+  auto& bus = dynamic_cast<Transport&>(learner.transport());  // bytes on the wire, as a forger sends them
   const auto chunks = batchOf(rc, 0, 0);
   std::vector<std::vector<uint8_t>> sent;
   for (const auto& c : chunks) sent.push_back(signedBytes(*run.actors[0], kRolloutChannel, c));
