@@ -79,23 +79,29 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::M
   const auto& terms = envs_[0]->rewardTermNames();
   num_terms_ = static_cast<int>(terms.size());
 
-  model_ = std::make_unique<model::ActorCritic<float>>(spec, config_.model);
-  policy_param_count_ = model_->policyParamCount();
-  int model_param_count = static_cast<int>(model_->params().size());
-  if (config_.learner == "off_policy") {
-    squashed_ = std::make_unique<SquashedBehaviour>(config_, spec);
+  // The whole model once, for its parameter count (a learner may broadcast it whole) and the
+  // initial parameters' draws; the actor keeps only its policy half.
+  int model_param_count = 0;
+  {
+    model::ActorCritic<float> model(spec, config_.model);
+    model_param_count = model.params().size();
+    // Own initial parameters: used only with start_without_learner, and deterministic per seed.
+    Rng init_rng = envRng(config_.seed, options_.actor_id, -1);
+    model.initialize(init_rng);
+    policy_ = model::InferencePolicy<float>::of(model);
+    policy_param_count_ = policy_->params().size();
+    if (config_.learner == "off_policy") {
+      squashed_ = std::make_unique<SquashedBehaviour>(config_, spec);
+      squashed_->initialize(init_rng);
+    }
+  }
+  if (squashed_) {
     policy_param_count_ = model_param_count = squashed_->paramCount();  // the learner sends the policy only
   }
   params_check_ = std::make_unique<ParamsCheck>(ParamsExpectation{
       .run_id = options_.run_id, .task = config_.task, .method = model::methodName(config_.method),
       .policy_param_count = policy_param_count_, .model_param_count = model_param_count,
       .obs_dim = obs_dim_, .max_version_step = options_.max_version_step});
-  {
-    // Own initial parameters: used only with start_without_learner, and deterministic per seed.
-    Rng init_rng = envRng(config_.seed, options_.actor_id, -1);
-    model_->initialize(init_rng);
-    if (squashed_) squashed_->initialize(init_rng);
-  }
   if (options_.start_without_learner) version_ = 0;
 
   rollout_.allocate(num_envs_, horizon_, obs_dim_, act_dim_, terms);
@@ -106,7 +112,7 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::M
   ep_success_.assign(num_envs_, -1);
   ep_terms_.assign(static_cast<std::size_t>(num_envs_) * std::max(num_terms_, 1), 0.0f);
   log_std_.resize(act_dim_);
-  pending_params_.resize(std::max<std::size_t>(model_->params().size(), model_param_count));
+  pending_params_.resize(std::max(policy_param_count_, model_param_count));
   pending_mean_.resize(obs_dim_);
   pending_std_.resize(obs_dim_);
 
@@ -193,9 +199,10 @@ void Actor::swapInPending() {
     squashed_->set(pending_params_.data(), pending_has_norm_ ? pending_mean_.data() : nullptr,
                    pending_has_norm_ ? pending_std_.data() : nullptr);
   } else {
-    auto& values = model_->params().values();
-    std::copy(pending_params_.begin(), pending_params_.begin() + pending_count_, values.data());
-    if (pending_has_norm_) model_->obsNormalizer().setMeanStd(pending_mean_.data(), pending_std_.data());
+    // The policy prefix (a whole model's critic part is not the actor's).
+    auto& values = policy_->params().values();
+    std::copy(pending_params_.begin(), pending_params_.begin() + std::min<int>(pending_count_, values.size()), values.data());
+    if (pending_has_norm_) policy_->obsNormalizer().setMeanStd(pending_mean_.data(), pending_std_.data());
   }
   version_ = pending_version_;
   pending_version_ = -1;
@@ -260,7 +267,7 @@ bool Actor::collectAndPublish() {
   const int E = num_envs_;
   rollout_.clearEvents();
   if (squashed_) log_std_.setZero();  // SAC's std depends on the state; the field is PPO's
-  else model_->logStd(log_std_);
+  else policy_->logStd(log_std_);
   rollout_.setLogStd(log_std_.data());
 
   for (int e = 0; e < E; ++e) envs_[e]->observe(rollout_.obsAt(0, e));
@@ -275,7 +282,7 @@ bool Actor::collectAndPublish() {
                        Eigen::Map<Mat<float>>(rollout_.meanAt(t, 0), act_dim_, E), log_prob);
         return;
       }
-      auto mean = model_->actMean(obs);
+      auto mean = policy_->actMean(obs);
       Eigen::Map<Mat<float>>(rollout_.meanAt(t, 0), act_dim_, E) = mean;
     });
     float* reward = rollout_.reward.data() + rollout_.step(t, 0);

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "common/config/run_config.hpp"
-#include "common/model/actor_critic.hpp"
+#include "common/model/inference_policy.hpp"
 #include "common/sim/registry.hpp"
 #include "actors/await_budget.hpp"
 #include "actors/params_check.hpp"
@@ -127,7 +127,8 @@ class Actor {
   const transport::MessageBus& transport() const { return *transport_; }
   const rollout::Rollout& lastRollout() const { return rollout_; }
   int numEnvs() const { return num_envs_; }
-  model::ActorCritic<float>& model() { return *model_; }
+  // What the actor acts with (learner: ppo): the policy half of the learner's model.
+  model::InferencePolicy<float>& policy() { return *policy_; }
   void publishHeartbeat();
 
   // The environments between two rollouts (actors/actor_environments.cpp): each task's state and
@@ -161,8 +162,8 @@ class Actor {
   std::unique_ptr<task::TaskFactory> factory_;
   std::vector<std::unique_ptr<task::Task>> envs_;
   std::vector<Rng> rngs_;
-  std::unique_ptr<model::ActorCritic<float>> model_;
-  // learner: off_policy: the actions come from the SAC policy instead (model_ only sizes nothing).
+  std::unique_ptr<model::InferencePolicy<float>> policy_;  // no critic: the actor never trains
+  // learner: off_policy: the actions come from the SAC policy instead (policy_ only sizes nothing).
   std::unique_ptr<SquashedBehaviour> squashed_;
   int policy_param_count_ = 0;  // the policy + log-std prefix of the flat parameters
   std::unique_ptr<ParamsCheck> params_check_;  // made once the model's sizes are known

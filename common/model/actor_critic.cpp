@@ -21,7 +21,7 @@ ActorCritic<S>::ActorCritic(const sym::SymmetrySpec& spec, const ModelConfig& co
       config_(config),
       maps_(buildAgentMaps(config.method, spec_)),
       policy_(params_, "policy", &maps_, config.policy_hidden, config.activation),
-      log_std_(params_, "policy.log_std", logStdClasses()),
+      log_std_(params_, "policy.log_std", logStdClasses(config.method, spec_)),
       critic_(params_, "critic", &maps_, config.critic_hidden, config.critic_head_hidden, config.activation),
       obs_norm_(spec_.obsDim()),
       value_norm_(1) {
@@ -36,13 +36,12 @@ ActorCritic<S>::ActorCritic(const sym::SymmetrySpec& spec, const ModelConfig& co
   for (int i = 0; i < spec_.numAgents(); ++i) act_t_transpose_.push_back(spec_.actTransform(i).transpose());
 }
 
-template <typename S>
-std::vector<int> ActorCritic<S>::logStdClasses() const {
-  const int c = spec_.actCentralDim(), s = spec_.actLimbDim(), a = spec_.actDim();
+std::vector<int> logStdClasses(Method method, const sym::SymmetrySpec& spec) {
+  const int c = spec.actCentralDim(), s = spec.actLimbDim(), a = spec.actDim();
   std::vector<int> classes(a);
-  switch (config_.method) {
+  switch (method) {
     case Method::kMasa:
-      return spec_.actClasses();
+      return spec.actClasses();
     case Method::kMa:
       // Parameter sharing without symmetry: one std per limb slot, each central joint its own.
       for (int d = 0; d < a; ++d) classes[d] = d < c ? d : c + (d - c) % s;

@@ -47,6 +47,10 @@ struct ModelConfig {
   ActionSquash squash = ActionSquash::kNone;  // set from a policy file, never from a config
 };
 
+// The log-std classes of a method: MASA ties by the symmetry's orbit classes, MA one std per limb
+// slot (each central joint its own), SA and SASA one per action dimension.
+std::vector<int> logStdClasses(Method method, const sym::SymmetrySpec& spec);
+
 template <typename S>
 class ActorCritic {
  public:
@@ -113,7 +117,6 @@ class ActorCritic {
   void load(std::istream& is, const std::string& source_name);
 
  private:
-  std::vector<int> logStdClasses() const;
   void normalizeInput(const ConstMatRef<S>& raw_obs);
   void computeSymmetryLosses();
 

@@ -39,7 +39,7 @@ const char* modeName(Mode m) {
 }
 
 PolicyRunner::PolicyRunner(policy::LoadedPolicy& policy, const DeployConfig& config, int64_t runner_id)
-    : cfg_(config), runner_id_(runner_id), model_(policy.model.get()) {
+    : cfg_(config), runner_id_(runner_id), model_(model::InferencePolicy<float>::of(*policy.model)) {
   factory_ = std::make_unique<task::TaskFactory>(task::taskCatalog(), policy.config.task, policy.spec, policy.config.env,
                                                  policy.config.origin, policy.source);
   task_ = factory_->create();

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "common/core/types.hpp"
+#include "common/model/inference_policy.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/sim/registry.hpp"
 #include "deploy/runner/deploy_config.hpp"
@@ -49,6 +50,8 @@ class PolicyRunner {
   ~PolicyRunner();
 
   int numJoints() const { return n_; }
+  // What it acts with: the policy half of the file's model, frozen (its parameters cannot be written).
+  model::InferencePolicy<float>& policy() { return *model_; }
   double periodS() const { return period_us_ * 1e-6; }
   double watchdogBoundS() const { return (stale_us_ + period_us_) * 1e-6; }
   Mode mode() const { return mode_; }
@@ -104,7 +107,8 @@ class PolicyRunner {
   int64_t runner_id_;
   std::unique_ptr<task::TaskFactory> factory_;
   std::unique_ptr<task::Task> task_;
-  model::ActorCritic<float>* model_;
+  // The policy half of the file's model (no critic on the robot), frozen for inference.
+  std::unique_ptr<model::InferencePolicy<float>> model_;
   int n_ = 0;
   int64_t period_us_ = 0, stale_us_ = 0;
   int settle_commands_ = 0;

@@ -185,8 +185,8 @@ TEST(ActorRollouts, ParametersPublishedMidRolloutApplyFromTheNextRollout) {
   }
   // The swapped-in parameters and normalizer are the broadcast ones.
   const auto msg = learner.message(2, 0.05f);
-  for (int i = 0; i < msg.num_params; ++i) ASSERT_EQ(actor.model().params().values()[i], msg.params[i]);
-  EXPECT_NEAR(actor.model().obsNormalizer().mean()[0], 0.1, 1e-6);
+  for (int i = 0; i < msg.num_params; ++i) ASSERT_EQ(actor.policy().params().values()[i], msg.params[i]);
+  EXPECT_NEAR(actor.policy().obsNormalizer().mean()[0], 0.1, 1e-6);
 }
 
 std::vector<std::vector<uint8_t>> runOnce(uint64_t seed, int threads) {
@@ -379,7 +379,7 @@ TEST(ActorRollouts, AVersionTheLearnerNeverPublishedIsGivenUpWhenTheLearnerKeeps
   actor.pollParams(10);
   ASSERT_TRUE(actor.collectAndPublish());
   EXPECT_EQ(actor.policyVersion(), 7);
-  EXPECT_EQ(actor.model().params().values().head(3), learner.model.params().values().head(3));
+  EXPECT_EQ(actor.policy().params().values().head(3), learner.model.params().values().head(3));
   // A repeat at the actor's version in between resets the count.
   bus.publish(transport::kPolicyChannel, learner.message(985, 0.25f));
   actor.pollParams(10);
@@ -402,7 +402,8 @@ TEST(ActorRollouts, WholeModelParametersAreAcceptedAsWellAsThePolicyPrefix) {
                       learner.model.params().values().data() + whole.num_params);
   bus.publish(transport::kPolicyChannel, whole);
   ASSERT_TRUE(actor.pollParams(10));
-  EXPECT_EQ(actor.model().params().values(), learner.model.params().values());
+  // The critic part is not the actor's: it keeps the policy prefix.
+  EXPECT_EQ(actor.policy().params().values(), learner.model.params().values().head(learner.model.policyParamCount()));
 }
 
 TEST(ActorRollouts, StartWithoutLearnerActsWithVersionZero) {

@@ -88,14 +88,15 @@ TEST(DeployRunner, ObservationFromAStateMessageEqualsTheTasksOwnInSimulation) {
 TEST(DeployRunner, FreezesItsPolicyAndActsWithTheBitsOfTheUnfrozenPolicy) {
   Fixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
-  EXPECT_THROW(f.lp.model->params().values(), std::exception);
+  EXPECT_THROW(r.policy().params().values(), std::exception);
+  EXPECT_EQ(r.policy().params().size(), f.lp.model->policyParamCount()) << "the policy half only: no critic on the robot";
   policy::LoadedPolicy unfrozen = policy::loadPolicyFile(kPolicy);
   Rng rng(5);
   std::normal_distribution<float> noise(0.0f, 1.0f);
   Mat<float> obs(f.lp.model->obsDim(), 1);
   for (int t = 0; t < 10; ++t) {
     for (float& x : obs.reshaped()) x = noise(rng);
-    const Mat<float> frozen_mean = f.lp.model->actMean(obs);
+    const Mat<float> frozen_mean = r.policy().actMean(obs);
     EXPECT_TRUE(frozen_mean == unfrozen.model->actMean(obs)) << "observation " << t;
   }
 }
