@@ -1,5 +1,6 @@
 // masa_roster: the keys and the roster of a signed run (common/transport/roster.hpp, message_sign.hpp).
-//   masa_roster make RUN_DIR --actors K [--runner]   a key per process, RUN_DIR/keys/<role><index>.key
+//   masa_roster make RUN_DIR --actors K [--runner] [--robot]
+//                                                   a key per process, RUN_DIR/keys/<role><index>.key
 //                                                   (mode 0600, directory 0700), and RUN_DIR/roster
 //                                                   with their public keys and the channels of each role
 //   masa_roster show ROSTER                          the senders, their key fingerprints and channels
@@ -34,7 +35,7 @@ void writeRoster(const transport::Roster& roster, const fs::path& path) {
   fs::rename(tmp, path);  // appears whole
 }
 
-int make(const std::string& dir, int actors, bool runner) {
+int make(const std::string& dir, int actors, bool runner, bool robot) {
   const fs::path run(dir), keys = run / "keys", roster_path = run / "roster";
   fs::create_directories(keys);
   ::chmod(keys.c_str(), 0700);
@@ -43,6 +44,7 @@ int make(const std::string& dir, int actors, bool runner) {
   std::vector<transport::SenderId> wanted = {{transport::Role::kLearner, 0}};
   for (int a = 0; a < actors; ++a) wanted.push_back({transport::Role::kActor, static_cast<uint32_t>(a)});
   if (runner) wanted.push_back({transport::Role::kRunner, 0});
+  if (robot) wanted.push_back({transport::Role::kRobot, 0});
   int made = 0;
   for (const transport::SenderId& id : wanted) {
     if (roster.find(id)) continue;
@@ -75,16 +77,17 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::string dir, path;
   int actors = 1;
-  bool runner = false;
+  bool runner = false, robot = false;
   auto* make_cmd = app.add_subcommand("make", "make the keys and the roster of a run directory (keeps what is there)");
   make_cmd->add_option("run_dir", dir, "the run directory")->required();
   make_cmd->add_option("--actors", actors, "actors of the run (keys actor0 .. actorK-1)")->check(CLI::Range(0, 1 << 20));
   make_cmd->add_flag("--runner", runner, "a key for the robot's policy runner (masa_deploy), on the robot command channel");
+  make_cmd->add_flag("--robot", robot, "a key for the robot (masa_sim_robot --signing-key), on the robot state channel");
   auto* show_cmd = app.add_subcommand("show", "the senders of a roster");
   show_cmd->add_option("roster", path, "a roster file")->required();
   CLI11_PARSE(app, argc, argv);
   try {
-    if (*make_cmd) return make(dir, actors, runner);
+    if (*make_cmd) return make(dir, actors, runner, robot);
     return show(path);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_roster: %s\n", e.what());

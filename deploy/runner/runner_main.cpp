@@ -8,7 +8,11 @@
 // keys in KEYS (a .pub file, or a directory of them; masa_seal keygen / sign make them).
 // --roster ROSTER --signing-key KEY signs every command as `runner 0` of the roster (masa_roster make
 // DIR --runner makes DIR/roster and DIR/keys/runner0.key), for a robot side that verifies commands
-// (masa_sim_robot --roster ROSTER); the state is still read unsigned.
+// (masa_sim_robot --roster ROSTER). --verify-state (with --roster) takes only state signed by robot 0
+// of the roster and new (its counter window), refusing the rest by reason (masa_roster make DIR
+// --robot; masa_sim_robot --signing-key DIR/keys/robot0.key); without it the state is read unsigned.
+// Either way the start guard hears every runner's commands, signed or not, unverified: it errs
+// towards refusing to start.
 // Exit codes: 0 stopped (signal, --duration, --max-policy-steps), 2 error, 3 start guard refused or
 // another runner appeared, 4 stopped by the watchdog or the emergency stop (--exit-on-trip).
 #include <CLI/CLI.hpp>
@@ -135,6 +139,10 @@ int main(int argc, char** argv) {
   auto* key_opt = app.add_option("--signing-key", signing_key, "the runner's private key file (mode 0600), with --roster");
   roster_opt->needs(key_opt);
   key_opt->needs(roster_opt);
+  bool verify_state = false;
+  app.add_flag("--verify-state", verify_state,
+               "take only state messages signed by robot 0 of --roster (masa_roster make DIR --robot), refuse the rest")
+      ->needs(roster_opt);
   CLI11_PARSE(app, argc, argv);
   if (require_signed != !trusted_keys_path.empty()) {
     std::fprintf(stderr, require_signed ? "masa_deploy: --require-signed needs --trusted-keys (the public keys a policy may be signed by)\n"
@@ -168,6 +176,18 @@ int main(int argc, char** argv) {
                    integrity::keyFingerprint(signer->publicKey()).c_str(), roster_file.c_str());
     }
     transport::SignedPublisher commands(lcm, signer);
+    // Verified state (opt-in) comes through a transport of its own that checks every message
+    // against the roster; the command channel stays on `lcm`, unverified, for the start guard.
+    std::unique_ptr<transport::Transport> verifying;
+    if (verify_state) {
+      transport::SignedMode watch;
+      watch.roster = std::make_shared<transport::Roster>(transport::Roster::load(roster_file));
+      if (!watch.roster->find({transport::Role::kRobot, 0}))
+        throw std::runtime_error("--verify-state: the roster " + roster_file + " names no robot 0 (masa_roster make DIR --robot)");
+      verifying = std::make_unique<transport::Transport>(url.empty() ? cfg.lcm_url : url, watch);
+      std::fprintf(stderr, "masa_deploy: state taken only signed by robot 0 of %s\n", roster_file.c_str());
+    }
+    transport::Transport& state_in = verifying ? *verifying : lcm;
     std::fprintf(stderr,
                  "masa_deploy: task %s, method %s (equivariance error %.1e), %d joints, %.1f Hz, watchdog %.0f ms "
                  "(safe command within %.0f ms), state %s, commands %s, id %lld; %s%s\n",
@@ -195,7 +215,7 @@ int main(int argc, char** argv) {
     state.joint_velocity.reserve(runner.numJoints());
     state.joint_torque.reserve(runner.numJoints());
     int64_t rejected_states = 0;
-    lcm.subscribeRaw(cfg.state_channel, [&](const void* data, int size) {
+    state_in.subscribeRaw(cfg.state_channel, [&](const void* data, int size) {
       const int64_t rx = steadyMicros();
       if (transport::decodeChecked(data, size, state) != transport::WireVerdict::kOk) {
         ++rejected_states;
@@ -205,7 +225,10 @@ int main(int argc, char** argv) {
     });
 
     const int64_t guard_end = steadyMicros() + static_cast<int64_t>(cfg.start_guard_s * 1e6);
-    while (steadyMicros() < guard_end && !g_stop) lcm.handleTimeout(10);
+    while (steadyMicros() < guard_end && !g_stop) {
+      lcm.handleTimeout(10);
+      if (verifying) verifying->drain();
+    }
     if (foreign > 0) {
       std::fprintf(stderr, "masa_deploy: REFUSED: another runner (id %lld) publishes on %s; stop it first\n",
                    static_cast<long long>(foreign_id), cfg.command_channel.c_str());
@@ -258,7 +281,9 @@ int main(int argc, char** argv) {
                      static_cast<long long>(published), static_cast<long long>(runner.policySteps()));
         next_status += 1000000;
       }
-      waitForWork(lcm, runner, cfg, warmed_for);
+      // The state wakes the runner; the other runners' commands (on lcm) are read between.
+      waitForWork(state_in, runner, cfg, warmed_for);
+      if (verifying) lcm.drain();
     }
     std::fprintf(stderr,
                  "masa_deploy: stopped in mode %s (%s); %lld states (%lld ignored, %lld rejected by the wire guard), "
@@ -273,6 +298,7 @@ int main(int argc, char** argv) {
                  static_cast<long long>(latency.to_poll.quantile(0.99)), static_cast<long long>(latency.in_poll.quantile(0.5)),
                  static_cast<long long>(latency.in_poll.quantile(0.99)), static_cast<long long>(latency.in_publish.quantile(0.5)),
                  static_cast<long long>(latency.in_publish.quantile(0.99)));
+    if (verifying) std::fprintf(stderr, "masa_deploy: state refused before decoding: %s\n", verifying->rejectSummary().c_str());
     return exit_code;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_deploy: %s\n", e.what());

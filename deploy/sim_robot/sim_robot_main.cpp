@@ -14,6 +14,8 @@
 // signed by a sender the roster lets publish on the command channel (runner 0, masa_roster make DIR
 // --runner; masa_deploy --roster --signing-key) and is new (counter window); others are refused and
 // counted by reason, printed at the end. Without it, commands are taken signed or not (unverified).
+// --signing-key DIR/keys/robot0.key (with --roster; masa_roster make DIR --robot): every state message
+// is signed as robot 0, for a runner that verifies the state (masa_deploy --verify-state).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -78,6 +80,10 @@ int main(int argc, char** argv) {
   std::string roster_file;
   app.add_option("--roster", roster_file,
                  "take only commands signed by a sender this roster permits on the command channel (runner 0)");
+  std::string signing_key;
+  app.add_option("--signing-key", signing_key,
+                 "sign every state message as robot 0 of --roster with this private key (masa_roster make DIR --robot)")
+      ->needs("--roster");
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
@@ -104,6 +110,12 @@ int main(int argc, char** argv) {
                    roster_file.c_str(), watch.roster->entries().size());
     }
     transport::Transport& command_in = verifying ? *verifying : lcm;
+    std::shared_ptr<transport::MessageSigner> state_signer;
+    if (!signing_key.empty()) {
+      state_signer = transport::loadSignedMode(roster_file, signing_key, {transport::Role::kRobot, 0}).signer;
+      std::fprintf(stderr, "masa_sim_robot: state signed as robot 0 with %s\n", signing_key.c_str());
+    }
+    transport::SignedPublisher state_out(lcm, state_signer);
     deploy::CommandLink link(loss, delay_ms, jitter_ms, fault_seed);
     deploy::RunRecord record(*task);
     const auto t_start = Clock::now();
@@ -123,7 +135,7 @@ int main(int argc, char** argv) {
     const auto publishState = [&](double sim_t) {
       robot.fillState(st, state_faults, sim_t);
       st.utime = utime = std::max(utime + 1, transport::wallClockMicros());
-      if (!link.loseState()) lcm.publish(state_channel, st);
+      if (!link.loseState()) state_out.publish(state_channel, st);
     };
 
     // Until the first command: state at the physics rate, physics paused.

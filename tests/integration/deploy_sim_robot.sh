@@ -22,6 +22,10 @@
 #                 the roster and unsigned ones are refused and counted (replayed, not_permitted,
 #                 unauthenticated) and none is taken (no physics step in mode 4); a robot that does not verify takes the signed commands too; a verifying
 #                 robot refuses every command of an unsigned runner and never moves
+#   signed_state  the robot signs its state as robot 0 (masa_roster make --robot; masa_sim_robot
+#                 --signing-key) and the runner verifies it (--verify-state): it walks the robot while
+#                 a forger's replayed, actor-signed and unsigned states (NaN angles, a utime from the
+#                 future) are refused and counted; the same forger trips a runner that does not verify
 # A real-time runner on a loaded machine can miss its state for 50 ms and trip its watchdog, which is
 # the watchdog doing its job, not what these cases test: walk, walk_tuned, faults and crouch (and
 # stale and nan, for a trip before their fault) say such a run and try it once more; a second trip
@@ -227,7 +231,7 @@ refusals)
   ;;
 signed_commands)
   roster_bin="$build/tools/masa_roster"
-  forger="$build/tests/masa_test_robot_command_forger"
+  forger="$build/tests/masa_test_robot_message_forger"
   for b in "$roster_bin" "$forger"; do [ -x "$b" ] || fail "$b is missing: build first"; done
   "$roster_bin" make "$work/keys" --actors 1 --runner > "$work/roster.log" 2>&1 || fail "masa_roster make failed"
   roster="$work/keys/roster"
@@ -266,5 +270,49 @@ signed_commands)
   grep -qE "MASA_ROBOT_COMMAND: [^;]*unauthenticated [1-9]" "$work/sim3.log" || fail "the unsigned commands were not counted as unauthenticated"
   echo "PASS: the robot took the runner's signed commands only; forged, replayed and unsigned ones were refused"
   ;;
-*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands PORT"; exit 2 ;;
+signed_state)
+  roster_bin="$build/tools/masa_roster"
+  forger="$build/tests/masa_test_robot_message_forger"
+  for b in "$roster_bin" "$forger"; do [ -x "$b" ] || fail "$b is missing: build first"; done
+  "$roster_bin" make "$work/keys" --actors 1 --runner --robot > "$work/roster.log" 2>&1 || fail "masa_roster make failed"
+  roster="$work/keys/roster"
+  robot=(--roster "$roster" --signing-key "$work/keys/keys/robot0.key")
+  runner=(--roster "$roster" --signing-key "$work/keys/keys/runner0.key")
+  forge=(--state --roster "$roster" --signing-key "$work/keys/keys/actor0.key" --actor 0)
+  # 1. A signing robot, a runner that verifies the state, and the forger: the runner walks the robot.
+  for attempt in 1 2; do
+    "$sim" "$policy" --seed 0 --duration 4.5 --quiet "${robot[@]}" > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$forger" "${forge[@]}" --duration 8 > "$work/forger.log" 2>&1 & forger_pid=$!; pids+=($forger_pid)
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" "${runner[@]}" --verify-state --max-policy-steps 100 \
+      --exit-on-trip --quiet > "$work/deploy.log" 2>&1
+    rc=$?
+    wait "$sim_pid"; kill -INT "$forger_pid" 2>/dev/null; wait "$forger_pid"
+    [ "$rc" -eq 0 ] && break
+    retry_after_stale_trip "$attempt" "beside the state forger" ||
+      fail "the verifying runner exited with $rc (a trip: did it take a forged state?)"
+  done
+  grep -q "masa_deploy: state taken only signed by robot 0" "$work/deploy.log" || fail "the runner does not say it verifies the state"
+  grep -q "state signed as robot 0" "$work/sim.log" || fail "the robot does not say it signs its state"
+  grep -q "policy phase" "$work/sim.log" || fail "the robot took none of the runner's policy commands"
+  grep -q "fell: no" "$work/sim.log" || fail "the robot fell under the verifying runner"
+  grep -qE "robot state forger: [1-9][0-9]* replays, [1-9][0-9]* states signed by actor 0, [1-9][0-9]* unsigned" \
+    "$work/forger.log" || fail "the forger sent nothing: $(cat "$work/forger.log")"
+  refused=$(grep "state refused before decoding" "$work/deploy.log") || fail "the verifying runner did not count refusals"
+  for reason in replayed not_permitted unauthenticated; do
+    [[ $refused =~ MASA_ROBOT_STATE:\ [^\;]*$reason\ [1-9] ]] || fail "no $reason state refused: $refused"
+  done
+  echo "verifying runner: $refused; $(grep -o 'forger: .*' "$work/forger.log")"
+  # 2. The same forger beside a runner that does not verify: a forged state reaches it and it leaves
+  # its policy (what the verification prevents, shown happening).
+  "$sim" "$policy" --seed 0 --duration 4.5 --quiet "${robot[@]}" > "$work/sim2.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+  "$forger" "${forge[@]}" --duration 8 > "$work/forger2.log" 2>&1 & forger_pid=$!; pids+=($forger_pid)
+  timeout -s INT 20 "$deploy" "$policy" --config "$config" "${runner[@]}" --max-policy-steps 100 --exit-on-trip --quiet \
+    > "$work/deploy2.log" 2>&1
+  rc=$?
+  kill -INT "$sim_pid" "$forger_pid" 2>/dev/null; wait "$sim_pid"; wait "$forger_pid"
+  [ "$rc" -eq 4 ] || fail "a runner that does not verify was not tripped by the forged state (exit $rc, 4 expected): the forgery proves nothing"
+  echo "runner that does not verify: $(grep -m1 -oE '(damping|hold|emergency stop): .*' "$work/deploy2.log")"
+  echo "PASS: the verifying runner took the robot's signed state only; replayed, actor-signed and unsigned state were refused"
+  ;;
+*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands|signed_state PORT"; exit 2 ;;
 esac

@@ -1,0 +1,95 @@
+// A hostile machine beside a robot whose commands (or state) are signed (issue #33, item 2), for
+// tests/integration/deploy_sim_robot.sh (cases signed_commands and signed_state). For every new
+// command the runner signs (a SIG1 trailer naming runner 0) it hears, it sends
+//   - the same bytes again (a replay) ............................................ replayed
+//   - the command changed (an emergency stop, mode 4, targets +0.3 rad, 10 s newer than the runner's
+//     so that it would win), signed with the key it holds, a key of the roster that may not command
+//     the robot (an actor's) ............................................................ not_permitted
+//   - the same changed command unsigned ............................................... unauthenticated
+// and at the end prints how many of each. A robot that took any changed command spends physics
+// steps in mode 4. The runner id stays the runner's: the runner's start guard, which does not
+// verify, would otherwise stop the runner (docs/reliability.md, "Signed robot commands").
+// With --state, the same for every new state message robot 0 signs: the replay, and the state
+// changed (NaN joint angles, utime 10 s newer) signed with the actor's key and unsigned. A runner
+// that took a changed state leaves its policy: NaN angles give the safe command, and a utime from
+// the future makes every real state look old until the watchdog trips.
+//   masa_test_robot_message_forger --roster DIR/roster --signing-key DIR/keys/actor0.key --actor 0 --duration S [--state]
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include "common/transport/channels.hpp"
+#include "common/transport/signed_publisher.hpp"
+#include "common/transport/transport.hpp"
+#include <limits>
+
+#include "masa/lcmt_robot_command.hpp"
+#include "masa/lcmt_robot_state.hpp"
+
+int main(int argc, char** argv) {
+  using namespace masa;
+  CLI::App app{"forges robot commands (or state) beside a signing runner (or robot) (tests)"};
+  std::string url, roster, key, channel = transport::kRobotCommandChannel, state_channel = transport::kRobotStateChannel;
+  bool state = false;
+  uint32_t actor = 0;
+  double duration = 5;
+  app.add_option("--url", url, "LCM provider URL (default: LCM_DEFAULT_URL)");
+  app.add_option("--roster", roster, "the roster that lists the key")->required();
+  app.add_option("--signing-key", key, "a private key of the roster that is not the runner's")->required();
+  app.add_option("--actor", actor, "the key's actor index in the roster")->capture_default_str();
+  app.add_option("--duration", duration, "seconds")->capture_default_str();
+  app.add_option("--command-channel", channel)->capture_default_str();
+  app.add_option("--state-channel", state_channel)->capture_default_str();
+  app.add_flag("--state", state, "forge robot 0's state messages instead of the runner's commands");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    auto signer = transport::loadSignedMode(roster, key, {transport::Role::kActor, actor}).signer;
+    transport::Transport lcm(url);
+    transport::SignedPublisher as_actor(lcm, signer);
+    int64_t replays = 0, actor_signed = 0, unsigned_sent = 0;
+    uint64_t newest = 0;
+    std::vector<uint8_t> copy;
+    // Only the signer's new messages: not this forger's own copies coming back.
+    const transport::Role victim = state ? transport::Role::kRobot : transport::Role::kRunner;
+    const std::string& on = state ? state_channel : channel;
+    lcm.subscribeRaw(on, [&](const void* data, int size) {
+      transport::SenderId sender;
+      uint64_t counter = 0;
+      if (!transport::peekSigner(data, size, sender, counter) || sender.role != victim || counter <= newest) return;
+      newest = counter;
+      copy.assign(static_cast<const uint8_t*>(data), static_cast<const uint8_t*>(data) + size);
+      const int body = size - transport::kSigTrailerBytes;
+      if (state) {
+        lcmt_robot_state st;
+        if (transport::decodeChecked(copy.data(), body, st) != transport::WireVerdict::kOk) return;
+        if (lcm.publishWire(on, copy.data(), size)) ++replays;
+        st.utime += 10000000;
+        for (auto& q : st.joint_position) q = std::numeric_limits<double>::quiet_NaN();
+        if (as_actor.publish(on, st)) ++actor_signed;
+        if (lcm.publish(on, st)) ++unsigned_sent;
+        return;
+      }
+      lcmt_robot_command cmd;
+      if (transport::decodeChecked(copy.data(), body, cmd) != transport::WireVerdict::kOk) return;
+      if (lcm.publishWire(on, copy.data(), size)) ++replays;
+      cmd.mode = 4;
+      cmd.utime += 10000000;
+      for (auto& p : cmd.position) p += 0.3;
+      if (as_actor.publish(on, cmd)) ++actor_signed;
+      if (lcm.publish(on, cmd)) ++unsigned_sent;
+    });
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(duration);
+    while (std::chrono::steady_clock::now() < end) lcm.handleTimeout(20);
+    const char* what = state ? "state" : "command";
+    std::printf("robot %s forger: %lld replays, %lld %ss signed by actor %u, %lld unsigned\n", what,
+                static_cast<long long>(replays), static_cast<long long>(actor_signed), what, actor,
+                static_cast<long long>(unsigned_sent));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "robot message forger: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
