@@ -26,15 +26,19 @@ ActorCritic<S>::ActorCritic(const sym::SymmetrySpec& spec, const ModelConfig& co
       obs_norm_(spec_.obsDim()),
       value_norm_(1) {
   params_.finalize();
-  // MASA must normalize equivariantly; SASA too, so that its losses compare A(o) with A(T_i o)
-  // through the same normalization (T_i commutes with a symmetric normalizer).
-  if (config.method == Method::kMasa || config.method == Method::kSasa) {
-    std::vector<sym::SparseMap> t;
-    for (int i = 0; i < spec_.numAgents(); ++i) t.push_back(spec_.obsTransform(i));
-    obs_norm_.setSymmetry(t, spec_.obsClasses());
-  }
+  symmetrizeNormalizer(obs_norm_, config.method, spec_);
   for (int i = 0; i < spec_.numAgents(); ++i) act_t_transpose_.push_back(spec_.actTransform(i).transpose());
 }
+
+template <typename S>
+void symmetrizeNormalizer(RunningMeanStd<S>& norm, Method method, const sym::SymmetrySpec& spec) {
+  if (method != Method::kMasa && method != Method::kSasa) return;
+  std::vector<sym::SparseMap> t;
+  for (int i = 0; i < spec.numAgents(); ++i) t.push_back(spec.obsTransform(i));
+  norm.setSymmetry(t, spec.obsClasses());
+}
+template void symmetrizeNormalizer<float>(RunningMeanStd<float>&, Method, const sym::SymmetrySpec&);
+template void symmetrizeNormalizer<double>(RunningMeanStd<double>&, Method, const sym::SymmetrySpec&);
 
 std::vector<int> logStdClasses(Method method, const sym::SymmetrySpec& spec) {
   const int c = spec.actCentralDim(), s = spec.actLimbDim(), a = spec.actDim();

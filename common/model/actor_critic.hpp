@@ -51,6 +51,11 @@ struct ModelConfig {
 // slot (each central joint its own), SA and SASA one per action dimension.
 std::vector<int> logStdClasses(Method method, const sym::SymmetrySpec& spec);
 
+// MASA must normalize observations equivariantly; SASA too, so that its losses compare A(o) with
+// A(T_i o) through the same normalization (T_i commutes with a symmetric normalizer). Others: as is.
+template <typename S>
+void symmetrizeNormalizer(RunningMeanStd<S>& norm, Method method, const sym::SymmetrySpec& spec);
+
 template <typename S>
 class ActorCritic {
  public:

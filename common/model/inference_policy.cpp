@@ -14,11 +14,7 @@ InferencePolicy<S>::InferencePolicy(const sym::SymmetrySpec& spec, const ModelCo
       log_std_(params_, "policy.log_std", logStdClasses(config.method, spec_)),
       obs_norm_(spec_.obsDim()) {
   params_.finalize();
-  if (config.method == Method::kMasa || config.method == Method::kSasa) {
-    std::vector<sym::SparseMap> t;
-    for (int i = 0; i < spec_.numAgents(); ++i) t.push_back(spec_.obsTransform(i));
-    obs_norm_.setSymmetry(t, spec_.obsClasses());
-  }
+  symmetrizeNormalizer(obs_norm_, config.method, spec_);
 }
 
 template <typename S>

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/core/binary_io.hpp"
+#include "common/model/actor_critic.hpp"
 #include "common/nn/serialize.hpp"
 #include "common/model/squashed_gaussian.hpp"
 
@@ -56,11 +57,7 @@ SacPolicy<S>::SacPolicy(const sym::SymmetrySpec& spec, const SacPolicyShape& sha
       obs_norm_(spec_.obsDim()) {
   MASA_CHECK(shape.log_std_min < shape.log_std_max, "log-std bounds are empty");
   params_.finalize();
-  if (shape.method == model::Method::kMasa || shape.method == model::Method::kSasa) {
-    std::vector<SparseMap> t;
-    for (int i = 0; i < spec_.numAgents(); ++i) t.push_back(spec_.obsTransform(i));
-    obs_norm_.setSymmetry(t, spec_.obsClasses());
-  }
+  model::symmetrizeNormalizer(obs_norm_, shape.method, spec_);
   if (shape.method == model::Method::kSasa)
     for (int i = 0; i < spec_.numAgents(); ++i) {
       sym_t_.push_back(withUnsignedCopy(spec_.actTransform(i)));

@@ -4,18 +4,11 @@
 # (clocks aside). The replay buffer, the networks, their optimizers, the fitted normalizer and the
 # generator all travel in off_policy_state.bin; the stop falls after the warm-up, so all of them matter.
 #   tests/integration/off_policy_resume_exact.sh BUILD_DIR WORK_DIR
-set -euo pipefail
-build=$(cd "$1" && pwd) work=$2
-rm -rf "$work" && mkdir -p "$work" && cd "$work"
-fail() { echo "FAIL: $*"; for f in *.log; do echo "--- $f"; tail -n 5 "$f"; done; exit 1; }
-export OMP_NUM_THREADS=1
-train=("$build/tools/masa_train" --quiet --threads 1)
+source "$(dirname "$0")/masa_train_case.sh"
 tiny=(--set task=a1_beam --set learner=off_policy --set ppo.num_envs=8 --set ppo.horizon=16 --set env.max_episode_steps=40
       --set sac.learning_starts=200 --set sac.updates_per_step=0.25 --set sac.batch_size=16 --set "sac.policy_hidden=[16]"
       --set "sac.q_hidden=[16]" --set sac.n_step=2 --set runner.checkpoint_every=3 --set runner.eval_every=4
       --set runner.eval_episodes=1 --set runner.plot_every=0)
-strip() { awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) skip[c] = ($c == "wall_time_s" || $c == "fps") }
-                   { line = ""; for (c = 1; c <= NF; c++) if (!skip[c]) line = line $c ","; print line }' "$1"; }
 "${train[@]}" --updates 12 --run-dir whole "${tiny[@]}" > whole.log 2>&1 || fail "the whole run failed"
 "${train[@]}" --updates 5 --run-dir parts "${tiny[@]}" > parts1.log 2>&1 || fail "the first part failed"
 [ -s parts/off_policy_state.bin ] || fail "no off_policy_state.bin beside the checkpoint"

@@ -4,20 +4,12 @@
 # guarded, decoded): the same metrics update by update (clocks aside) and the same policy
 # parameters, for PPO and for learner: off_policy (issue #32, item 5).
 #   tests/integration/train_bus_same_run.sh BUILD_DIR WORK_DIR
-set -euo pipefail
-build=$(cd "$1" && pwd) work=$2
-rm -rf "$work" && mkdir -p "$work" && cd "$work"
-fail() { echo "FAIL: $*"; for f in *.log; do echo "--- $f"; tail -n 5 "$f"; done; exit 1; }
-export OMP_NUM_THREADS=1
-train=("$build/tools/masa_train" --quiet --threads 1)
+source "$(dirname "$0")/masa_train_case.sh"
 tiny=(--set task=a1_beam --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.num_envs=8
       --set ppo.horizon=8 --set ppo.minibatch_size=64 --set env.max_episode_steps=40 --set runner.eval_every=3
       --set runner.eval_episodes=1 --set runner.plot_every=0)
 off=(--set learner=off_policy --set sac.learning_starts=96 --set sac.batch_size=16 --set sac.policy_hidden=[16]
      --set sac.q_hidden=[16] --set sac.updates_per_step=0.5)
-# The metrics without the clocks (wall_time_s, fps), for comparing runs.
-strip() { awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) skip[c] = ($c == "wall_time_s" || $c == "fps") }
-                   { line = ""; for (c = 1; c <= NF; c++) if (!skip[c]) line = line $c ","; print line }' "$1"; }
 # The policy file's parameters: what follows its text header (the seal and the build's name differ).
 params() { python3 -c 'import sys; b = open(sys.argv[1], "rb").read(); print(b[b.index(b"# Written by masa"):].split(b"\n", 1)[1].hex())' "$1"; }
 

@@ -4,18 +4,10 @@
 # or was killed (SIGTERM) in the middle of a rollout; the environments go on from actor_state.bin.
 # Without that file the environments restart from a reset and the log says why.
 #   tests/integration/train_resume_exact.sh BUILD_DIR WORK_DIR
-set -euo pipefail
-build=$(cd "$1" && pwd) work=$2
-rm -rf "$work" && mkdir -p "$work" && cd "$work"
-fail() { echo "FAIL: $*"; for f in *.log; do echo "--- $f"; tail -n 5 "$f"; done; exit 1; }
-export OMP_NUM_THREADS=1
-train=("$build/tools/masa_train" --quiet --threads 1)
+source "$(dirname "$0")/masa_train_case.sh"
 tiny=(--set task=a1_beam --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.num_envs=8
       --set ppo.horizon=8 --set ppo.minibatch_size=64 --set env.max_episode_steps=40 --set runner.checkpoint_every=4
       --set runner.eval_every=5 --set runner.eval_episodes=1 --set runner.plot_every=0)
-# The metrics without the clocks (wall_time_s, fps), for comparing runs.
-strip() { awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) skip[c] = ($c == "wall_time_s" || $c == "fps") }
-                   { line = ""; for (c = 1; c <= NF; c++) if (!skip[c]) line = line $c ","; print line }' "$1"; }
 
 "${train[@]}" --updates 40 --run-dir whole "${tiny[@]}" > whole.log 2>&1 || fail "the whole run failed"
 
