@@ -31,6 +31,16 @@ class A1Beam final : public Task {
       : Task("a1_beam", std::move(model), spec, p,
              {{"velocity", 1.0}, {"alive", 1.0}, {"heading", 1.0}, {"action", -0.5}, {"lateral", -1.0}}) {
     target_velocity_ = p.number("target_velocity", 0.5);
+    // exp: the paper's exp(-|v_x - target|), which pays exp(-0.5) = 0.61 of itself for standing
+    // still; progress: clamp(v_x / target, -1, 1), which pays nothing for standing (issue #34: the
+    // off-policy learner settles on standing under the paper's form).
+    const std::string velocity_reward = p.text("velocity_reward", "exp");
+    if (velocity_reward != "exp" && velocity_reward != "progress")
+      throw ConfigError(p.origin("velocity_reward"), "env.velocity_reward",
+                        "must be exp or progress, got '" + velocity_reward + "'");
+    velocity_progress_ = velocity_reward == "progress";
+    if (velocity_progress_ && !(target_velocity_ > 0))
+      throw ConfigError(p.origin("target_velocity"), "env.target_velocity", "must be > 0 with velocity_reward: progress");
     kp_ = p.positive("kp", 40.0);
     kd_ = p.number("kd", 1.0);
     action_scale_ = p.positive("action_scale", 0.25);
@@ -155,7 +165,8 @@ class A1Beam final : public Task {
     mju_quat2Mat(r, q + 3);
     double a2 = 0.0;
     for (double a : lastAction()) a2 += a * a;
-    raw[0] = std::exp(-std::abs(v[0] - target_velocity_));  // velocity
+    raw[0] = velocity_progress_ ? std::clamp(v[0] / target_velocity_, -1.0, 1.0)  // velocity
+                                : std::exp(-std::abs(v[0] - target_velocity_));
     raw[1] = 1.0;                                            // alive
     raw[2] = r[0];                                           // heading: trunk x axis, world x
     raw[3] = a2;                                             // action
@@ -181,6 +192,7 @@ class A1Beam final : public Task {
   }
 
  private:
+  bool velocity_progress_ = false;
   double target_velocity_, kp_, kd_, action_scale_, min_height_, min_up_, joint_noise_, vel_noise_;
   double beam_top_ = 0.0;
   int root_q_ = 0, root_v_ = 0;

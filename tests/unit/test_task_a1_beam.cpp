@@ -135,6 +135,31 @@ TEST(A1BeamReward, StandingStillEarnsOnlyThePartialSpeedTrackingReward) {
   EXPECT_EQ(rewardTerm(*t, "action"), 0.0);
 }
 
+// Issue #34: under the paper's exp(-|v - target|) standing still earns 0.61 of the speed term,
+// and the off-policy learner settles there. env.velocity_reward: progress pays v_x / target,
+// clamped to [-1, 1]: nothing for standing, the full term at the target, no more beyond it.
+TEST(A1BeamReward, TheProgressFormPaysNothingForStandingAndTheFullTermAtTheTarget) {
+  const double quat[4] = {1, 0, 0, 0};
+  for (const double vx : {0.0, 0.25, 0.5, 0.9, -0.8}) {
+    const TaskFactory f = runConfigFactory(kTask, {"env.velocity_reward=progress", "env.weights.velocity=2.0"});
+    auto t = f.create();
+    Rng rng(3);
+    t->reset(rng);
+    const double lin[3] = {vx, 0.0, 0.0};
+    setTrunk(*t, 0.0, 0.0, t->data()->qpos[2], quat, lin);
+    std::vector<float> zero(t->actDim(), 0.0f);
+    ASSERT_FALSE(t->step(zero.data()).terminated);
+    const double v = t->data()->qvel[0];  // after the step
+    EXPECT_DOUBLE_EQ(rewardTerm(*t, "velocity"), 2.0 * std::clamp(v / 0.5, -1.0, 1.0)) << "v_x " << vx;
+  }
+  try {
+    runConfigFactory(kTask, {"env.velocity_reward=linear"});
+    ADD_FAILURE() << "velocity_reward=linear was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("env.velocity_reward"), std::string::npos) << e.what();
+  }
+}
+
 TEST(A1BeamTermination, FallingBelowTheBeamEndsWithExactlyMinusOne) {
   const TaskFactory f = runConfigFactory(kTask);
   auto t = f.create();
