@@ -65,6 +65,63 @@ void writeJobRoster(const std::string& run_dir, const masa::transport::Roster& r
   std::filesystem::rename(tmp, path);
 }
 
+// How this learner authenticates (docs/reliability.md): a roster and its own key (a signed run),
+// the MPI job's keys made in memory (job_keys), no authentication, or the run key (lead rank: read
+// or made in the run directory; the other ranks get rank 0's over MPI afterwards).
+void chooseAuthentication(masa::learner::LearnerOptions& opt, const std::string& roster_file,
+                          const std::string& signing_key, std::string key_file, bool no_auth,
+                          const masa::transport::SignedMode* job_keys, bool job, bool lead) {
+  const bool signed_job = job_keys != nullptr;
+  if (!roster_file.empty()) {
+    if (job) throw std::runtime_error("--roster: an MPI job signs with keys its processes make in memory and gathers "
+                                      "their public keys over MPI; leave out --roster and --signing-key");
+    opt.signed_mode = masa::transport::loadSignedMode(roster_file, signing_key, {masa::transport::Role::kLearner, 0});
+    std::cout << "masa_learner: messages signed with " << signing_key << " ("
+              << masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()) << "), senders checked against the roster "
+              << roster_file << " (" << opt.signed_mode->roster->entries().size() << " senders)" << std::endl;
+  } else if (signed_job) {
+    opt.signed_mode = *job_keys;
+    if (lead)
+      std::cout << "masa_learner: messages signed with a key made in memory ("
+                << masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey())
+                << "), senders checked against the roster of the MPI job (" << opt.signed_mode->roster->entries().size()
+                << " senders)" << std::endl;
+  } else if (no_auth) {
+    std::cerr << "masa_learner: WARNING: --no-auth: messages are neither signed nor checked; anyone who can "
+                 "reach this network can feed this run rollouts\n";
+  } else if (lead) {
+    std::filesystem::create_directories(opt.run_dir);
+    if (key_file.empty()) key_file = (std::filesystem::path(opt.run_dir) / "run.key").string();
+    opt.run_key = masa::transport::readOrCreateRunKey(key_file);
+    std::cout << "masa_learner: messages authenticated with the run key " << key_file << " (key id "
+              << opt.run_key->id() << ")" << std::endl;
+  }
+}
+
+// What the learner says when it stops: chunks by drop reason, short batches, parameter repeats, the
+// MLP chunk widths, and the messages refused before decoding on each transport.
+void printClosingReport(masa::learner::Learner& learner, const std::string& who, bool lead) {
+  // What became of the actors' rollout chunks, by reason (lost: never arrived).
+  const auto& drops = learner.dropStats();
+  std::cout << who << ": rollout chunks accepted " << drops[masa::learner::DropReason::kAccepted];
+  for (int r = 1; r < masa::learner::kNumDropReasons; ++r) {
+    const auto reason = static_cast<masa::learner::DropReason>(r);
+    if (drops[reason] > 0) std::cout << ", " << masa::learner::dropReasonName(reason) << " " << drops[reason];
+  }
+  std::cout << std::endl;
+  std::cout << who << ": updates on batches short of lost environments " << learner.shortBatches() << std::endl;
+  if (lead)
+    std::cout << who << ": parameter broadcasts repeated for actors that had not acknowledged them "
+              << learner.unacknowledgedRepeats() << "; actors that acknowledged parameters "
+              << learner.acknowledgingActors() << std::endl;
+  std::cout << who << ": MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
+  std::cout << who << ": other messages rejected before decoding: " << learner.transport().rejectSummary();
+  // Rank 0 of several hears the actors' heartbeats on the parameters' URL, another transport.
+  if (&learner.publisher() != &learner.transport())
+    std::cout << "; on the parameters' URL " << learner.publisher().rejectSummary();
+  std::cout << std::endl;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -153,30 +210,8 @@ int main(int argc, char** argv) {
       ranks->broadcast(dir, 0);
       opt.run_dir.assign(dir.begin(), dir.end());
     }
-    if (!roster_file.empty()) {
-      if (job) throw std::runtime_error("--roster: an MPI job signs with keys its processes make in memory and gathers "
-                                        "their public keys over MPI; leave out --roster and --signing-key");
-      opt.signed_mode = masa::transport::loadSignedMode(roster_file, signing_key, {masa::transport::Role::kLearner, 0});
-      std::cout << "masa_learner: messages signed with " << signing_key << " ("
-                << masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()) << "), senders checked against the roster "
-                << roster_file << " (" << opt.signed_mode->roster->entries().size() << " senders)" << std::endl;
-    } else if (signed_job) {
-      opt.signed_mode = *job_keys;
-      if (lead)
-        std::cout << "masa_learner: messages signed with a key made in memory ("
-                  << masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey())
-                  << "), senders checked against the roster of the MPI job (" << opt.signed_mode->roster->entries().size()
-                  << " senders)" << std::endl;
-    } else if (no_auth) {
-      std::cerr << "masa_learner: WARNING: --no-auth: messages are neither signed nor checked; anyone who can "
-                   "reach this network can feed this run rollouts\n";
-    } else if (lead) {
-      std::filesystem::create_directories(opt.run_dir);
-      if (key_file.empty()) key_file = (std::filesystem::path(opt.run_dir) / "run.key").string();
-      opt.run_key = masa::transport::readOrCreateRunKey(key_file);
-      std::cout << "masa_learner: messages authenticated with the run key " << key_file << " (key id "
-                << opt.run_key->id() << ")" << std::endl;
-    }
+    chooseAuthentication(opt, roster_file, signing_key, key_file, no_auth, signed_job ? &*job_keys : nullptr,
+                         job != nullptr, lead);
     if (ranks && !no_auth && !signed_job) {
       // Rank 0's key for the other ranks, over MPI: never on a command line or in a shared file.
       std::vector<uint8_t> key;
@@ -220,25 +255,7 @@ int main(int argc, char** argv) {
     }
     std::cout << who << ": stopped after " << learner.updates() << " updates"
               << (lead ? "; checkpoint written" : "") << std::endl;
-    // What became of the actors' rollout chunks, by reason (lost: never arrived).
-    const auto& drops = learner.dropStats();
-    std::cout << who << ": rollout chunks accepted " << drops[masa::learner::DropReason::kAccepted];
-    for (int r = 1; r < masa::learner::kNumDropReasons; ++r) {
-      const auto reason = static_cast<masa::learner::DropReason>(r);
-      if (drops[reason] > 0) std::cout << ", " << masa::learner::dropReasonName(reason) << " " << drops[reason];
-    }
-    std::cout << std::endl;
-    std::cout << who << ": updates on batches short of lost environments " << learner.shortBatches() << std::endl;
-    if (lead)
-      std::cout << who << ": parameter broadcasts repeated for actors that had not acknowledged them "
-                << learner.unacknowledgedRepeats() << "; actors that acknowledged parameters "
-                << learner.acknowledgingActors() << std::endl;
-    std::cout << who << ": MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
-    std::cout << who << ": other messages rejected before decoding: " << learner.transport().rejectSummary();
-    // Rank 0 of several hears the actors' heartbeats on the parameters' URL, another transport.
-    if (&learner.publisher() != &learner.transport())
-      std::cout << "; on the parameters' URL " << learner.publisher().rejectSummary();
-    std::cout << std::endl;
+    printClosingReport(learner, who, lead);
     // Stopped because a rank heard nothing: not the run's end, so not success for a job script,
     // and the job's actors end with it (MPI_Abort), hung or not.
     if (cut_short) {
