@@ -80,6 +80,25 @@ struct CommandLatency {
   }
 };
 
+// The runner's last line: the mode it stopped in and why, the states and commands counted, and the
+// latency from a state's arrival to its command's publication, split by stage.
+void printStopLine(const deploy::PolicyRunner& runner, const CommandLatency& latency, int64_t published,
+                   int64_t rejected_states) {
+  std::fprintf(stderr,
+               "masa_deploy: stopped in mode %s (%s); %lld states (%lld ignored, %lld rejected by the wire guard), "
+               "%lld commands, %lld policy steps; latency state received -> command published: p50 %lld us, "
+               "p99 %lld us over %lld commands (until poll p50 %lld / p99 %lld us, poll %lld / %lld us, publish "
+               "%lld / %lld us)\n",
+               deploy::modeName(runner.mode()), runner.reason().c_str(), static_cast<long long>(runner.statesReceived()),
+               static_cast<long long>(runner.statesIgnored()), static_cast<long long>(rejected_states),
+               static_cast<long long>(published), static_cast<long long>(runner.policySteps()),
+               static_cast<long long>(latency.total.quantile(0.5)), static_cast<long long>(latency.total.quantile(0.99)),
+               static_cast<long long>(latency.total.count()), static_cast<long long>(latency.to_poll.quantile(0.5)),
+               static_cast<long long>(latency.to_poll.quantile(0.99)), static_cast<long long>(latency.in_poll.quantile(0.5)),
+               static_cast<long long>(latency.in_poll.quantile(0.99)), static_cast<long long>(latency.in_publish.quantile(0.5)),
+               static_cast<long long>(latency.in_publish.quantile(0.99)));
+}
+
 // Waits for the loop's next piece of work: a state, or a command's deadline; with the realtime
 // settings, also the warm-up before a command (realtime.warm_up_us) and, near a command, no sleep
 // at all (realtime.busy_poll_us), so that no thread wakeup stands between the state and the
@@ -285,19 +304,7 @@ int main(int argc, char** argv) {
       waitForWork(state_in, runner, cfg, warmed_for);
       if (verifying) lcm.drain();
     }
-    std::fprintf(stderr,
-                 "masa_deploy: stopped in mode %s (%s); %lld states (%lld ignored, %lld rejected by the wire guard), "
-                 "%lld commands, %lld policy steps; latency state received -> command published: p50 %lld us, "
-                 "p99 %lld us over %lld commands (until poll p50 %lld / p99 %lld us, poll %lld / %lld us, publish "
-                 "%lld / %lld us)\n",
-                 deploy::modeName(runner.mode()), runner.reason().c_str(), static_cast<long long>(runner.statesReceived()),
-                 static_cast<long long>(runner.statesIgnored()), static_cast<long long>(rejected_states),
-                 static_cast<long long>(published), static_cast<long long>(runner.policySteps()),
-                 static_cast<long long>(latency.total.quantile(0.5)), static_cast<long long>(latency.total.quantile(0.99)),
-                 static_cast<long long>(latency.total.count()), static_cast<long long>(latency.to_poll.quantile(0.5)),
-                 static_cast<long long>(latency.to_poll.quantile(0.99)), static_cast<long long>(latency.in_poll.quantile(0.5)),
-                 static_cast<long long>(latency.in_poll.quantile(0.99)), static_cast<long long>(latency.in_publish.quantile(0.5)),
-                 static_cast<long long>(latency.in_publish.quantile(0.99)));
+    printStopLine(runner, latency, published, rejected_states);
     if (verifying) std::fprintf(stderr, "masa_deploy: state refused before decoding: %s\n", verifying->rejectSummary().c_str());
     return exit_code;
   } catch (const std::exception& e) {
