@@ -29,6 +29,67 @@
 namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void onSignal(int) { g_stop.store(true); }
+// An actor of an MPI job: the plan learner rank 0 shares (run id, URLs, the run key or a signed
+// job) and this actor's keys made in memory; any failure ends the whole job.
+void takeJobPlan(masa::cluster::MpiJob& job, masa::actor::ActorOptions& opt, bool& no_auth, std::string& key_file) {
+  try {
+    // Before the plan, as every process of the job does (job_roster.hpp).
+    auto job_keys = masa::transport::jobSignedMode(
+        {masa::transport::Role::kActor, static_cast<uint32_t>(job.roleIndex())},
+        [&](const std::vector<uint8_t>& mine) { return job.gatherFromEveryProcess(mine); });
+    std::vector<uint8_t> bytes;
+    job.shareFromLearnerZero(bytes);
+    const auto plan = masa::cluster::JobPlan::decode(bytes);
+    opt.actor_id = job.roleIndex();
+    opt.run_id = plan.run_id;
+    opt.url = plan.url;
+    // Actor i reports to learner rank i mod (number of ranks).
+    opt.rollout_url =
+        masa::transport::rankRolloutUrl(plan.url, opt.actor_id % job.learnerCount(), job.learnerCount());
+    if (plan.key) {
+      masa::transport::RunKey k;
+      k.bytes = *plan.key;
+      opt.run_key = k;
+    }
+    if (plan.signed_job) opt.signed_mode = std::move(job_keys);
+    no_auth = !plan.key && !plan.signed_job;
+    key_file = plan.key ? "(from learner rank 0)" : plan.signed_job ? "(a key made in memory)" : "";
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "masa_actor: %s\n", e.what());
+    job.abort(2);
+  }
+}
+
+// How this actor authenticates (said on stderr): the MPI job's plan, a roster and its own key (a
+// signed run), no authentication, or the learner's run key read from key_file.
+void chooseAuthentication(masa::actor::ActorOptions& opt, const masa::cluster::MpiJob* job, const std::string& roster_file,
+                       const std::string& signing_key, const std::string& key_file, bool no_auth) {
+  if (job) {
+    std::fprintf(stderr, "masa_actor %d: actor %d of %d in an MPI job, rollouts to learner rank %d on %s; %s%s\n",
+                 opt.actor_id, opt.actor_id, job->actorCount(), opt.actor_id % job->learnerCount(),
+                 opt.rollout_url.c_str(),
+                 opt.signed_mode ? "messages signed with a key made in memory, "
+                 : opt.run_key   ? "messages authenticated with the job's run key"
+                                 : "WARNING: no message authentication (--no-auth)",
+                 opt.signed_mode ? (masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()) +
+                                    ", senders checked against the roster of the MPI job").c_str()
+                                 : "");
+  } else if (!roster_file.empty()) {
+    opt.signed_mode = masa::transport::loadSignedMode(
+        roster_file, signing_key, {masa::transport::Role::kActor, static_cast<uint32_t>(opt.actor_id)});
+    std::fprintf(stderr, "masa_actor %d: messages signed with %s (%s), senders checked against the roster %s\n",
+                 opt.actor_id, signing_key.c_str(),
+                 masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()).c_str(), roster_file.c_str());
+  } else if (no_auth) {
+    std::fprintf(stderr, "masa_actor %d: WARNING: --no-auth: messages are neither signed nor checked; anyone who "
+                         "can reach this network can make this actor act with their parameters\n", opt.actor_id);
+  } else {
+    opt.run_key = masa::transport::readRunKey(key_file);
+    std::fprintf(stderr, "masa_actor %d: messages authenticated with the run key %s (key id %s)\n", opt.actor_id,
+                 key_file.c_str(), opt.run_key->id().c_str());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -101,34 +162,7 @@ int main(int argc, char** argv) {
   app.add_option("--drop-seed", opt.drop_seed, "seed of the generator that picks the chunks to throw away")
       ->capture_default_str()->group("Fault injection");
   CLI11_PARSE(app, argc, argv);
-  if (job) {
-    try {
-      // Before the plan, as every process of the job does (job_roster.hpp).
-      auto job_keys = masa::transport::jobSignedMode(
-          {masa::transport::Role::kActor, static_cast<uint32_t>(job->roleIndex())},
-          [&](const std::vector<uint8_t>& mine) { return job->gatherFromEveryProcess(mine); });
-      std::vector<uint8_t> bytes;
-      job->shareFromLearnerZero(bytes);
-      const auto plan = masa::cluster::JobPlan::decode(bytes);
-      opt.actor_id = job->roleIndex();
-      opt.run_id = plan.run_id;
-      opt.url = plan.url;
-      // Actor i reports to learner rank i mod (number of ranks).
-      opt.rollout_url =
-          masa::transport::rankRolloutUrl(plan.url, opt.actor_id % job->learnerCount(), job->learnerCount());
-      if (plan.key) {
-        masa::transport::RunKey k;
-        k.bytes = *plan.key;
-        opt.run_key = k;
-      }
-      if (plan.signed_job) opt.signed_mode = std::move(job_keys);
-      no_auth = !plan.key && !plan.signed_job;
-      key_file = plan.key ? "(from learner rank 0)" : plan.signed_job ? "(a key made in memory)" : "";
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "masa_actor: %s\n", e.what());
-      job->abort(2);
-    }
-  }
+  if (job) takeJobPlan(*job, opt, no_auth, key_file);
   if (key_file.empty() && !no_auth && roster_file.empty()) {
     std::fprintf(stderr, "masa_actor: no key: give --roster RUN_DIR/roster with --signing-key RUN_DIR/keys/actorN.key "
                          "(a signed run), or --key-file RUN_DIR/run.key (the learner's run key), or --no-auth to run "
@@ -141,30 +175,7 @@ int main(int argc, char** argv) {
   opt.stop = &g_stop;
   try {
     const auto rc = masa::config::loadRunConfig(configs, overrides, run_config);
-    if (job) {
-      std::fprintf(stderr, "masa_actor %d: actor %d of %d in an MPI job, rollouts to learner rank %d on %s; %s%s\n",
-                   opt.actor_id, opt.actor_id, job->actorCount(), opt.actor_id % job->learnerCount(),
-                   opt.rollout_url.c_str(),
-                   opt.signed_mode ? "messages signed with a key made in memory, "
-                   : opt.run_key   ? "messages authenticated with the job's run key"
-                                   : "WARNING: no message authentication (--no-auth)",
-                   opt.signed_mode ? (masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()) +
-                                      ", senders checked against the roster of the MPI job").c_str()
-                                   : "");
-    } else if (!roster_file.empty()) {
-      opt.signed_mode = masa::transport::loadSignedMode(
-          roster_file, signing_key, {masa::transport::Role::kActor, static_cast<uint32_t>(opt.actor_id)});
-      std::fprintf(stderr, "masa_actor %d: messages signed with %s (%s), senders checked against the roster %s\n",
-                   opt.actor_id, signing_key.c_str(),
-                   masa::integrity::keyFingerprint(opt.signed_mode->signer->publicKey()).c_str(), roster_file.c_str());
-    } else if (no_auth) {
-      std::fprintf(stderr, "masa_actor %d: WARNING: --no-auth: messages are neither signed nor checked; anyone who "
-                           "can reach this network can make this actor act with their parameters\n", opt.actor_id);
-    } else {
-      opt.run_key = masa::transport::readRunKey(key_file);
-      std::fprintf(stderr, "masa_actor %d: messages authenticated with the run key %s (key id %s)\n", opt.actor_id,
-                   key_file.c_str(), opt.run_key->id().c_str());
-    }
+    chooseAuthentication(opt, job.get(), roster_file, signing_key, key_file, no_auth);
     masa::actor::Actor actor(rc, opt);
     // In an MPI job the actors end when the learner ranks say training is over.
     std::thread watcher;
