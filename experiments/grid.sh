@@ -3,7 +3,7 @@
 # one process, deterministic per seed) from the task's recipe, as many runs at once as there are
 # slots, then the comparison: figures, statistics and verdict of masa_compare (tools/compare.cpp).
 #   experiments/grid.sh --tasks "a1_beam" --methods "masa sa sasa ma" --seeds "0 1 2 3 4" \
-#       [--updates N] [--no-recipe] [--jobs N] [--threads T] [--hosts FILE] [--out DIR] [--set key=value ...]
+#       [--updates N] [--no-recipe | --recipe NAME] [--jobs N] [--threads T] [--hosts FILE] [--out DIR] [--set key=value ...]
 #   experiments/grid.sh --replot --out DIR      (only the comparison of an existing grid)
 #   experiments/grid.sh --extend N --out DIR    (the grid's runs go on to N updates each)
 #   experiments/grid.sh --out DIR --seeds "0 ... 9"  (more seeds, methods or tasks: the grid grows)
@@ -22,6 +22,8 @@
 # --milestone [TASK:]COLUMN=LEVEL (repeatable): the verdict adds when each run's COLUMN (a metrics.csv
 # column, e.g. an evaluation figure) first reaches LEVEL; kept in grid.txt, it can be added to a
 # grid at any time (a rerun or --replot) without changing its runs.
+# --recipe NAME: every run from configs/recipes/NAME.yaml (or that YAML file) instead of its task's
+# recipe, e.g. --recipe a1_beam_off_policy; --no-recipe: from the task's config alone.
 # MASA_BUILD_DIR chooses the build (default build).
 set -euo pipefail
 caller=$(pwd)
@@ -31,7 +33,7 @@ repo=$(pwd)
 # --out and --hosts are the caller's paths; MASA_BUILD_DIR is relative to the checkout.
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
 
-tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1 extend="" grown=()
+tasks="" methods="" seeds="" updates="" jobs="" threads=1 out="" hosts="" sets=() replot=0 recipe=1 recipe_given="" extend="" grown=()
 milestones=()
 status=0
 while [ $# -gt 0 ]; do
@@ -46,7 +48,8 @@ while [ $# -gt 0 ]; do
     --out) out=$2; shift 2 ;;
     --set) sets+=("$2"); shift 2 ;;
     --milestone) milestones+=("$2"); shift 2 ;;
-    --no-recipe) recipe=0; shift ;;
+    --no-recipe) recipe_given=0; shift ;;
+    --recipe) recipe_given=$2; shift 2 ;;
     --replot) replot=1; shift ;;
     --extend) extend=$2; shift 2 ;;
     --status) status=1; shift ;;
@@ -60,6 +63,14 @@ for x in "${milestones[@]+"${milestones[@]}"}"; do
 done
 [ ${#milestones[@]} -eq 0 ] || [ "$status" = 0 ] || { echo "grid.sh: --status only reads; give --milestone with --replot" >&2; exit 2; }
 [ -n "$out" ] && out=$(abs "$out")
+# The recipe: 1 = each task's own (configs/recipes/<task>.yaml), 0 = none, else one recipe for all
+# (a name of configs/recipes/ or a YAML file, kept as an absolute path).
+if [ -n "$recipe_given" ] && [ "$recipe_given" != 0 ]; then
+  if [ -f "$(abs "$recipe_given")" ]; then recipe_given=$(abs "$recipe_given")
+  elif [[ "$recipe_given" =~ ^[A-Za-z0-9_]+$ ]] && [ -f "configs/recipes/$recipe_given.yaml" ]; then :
+  else echo "grid.sh: --recipe '$recipe_given': no configs/recipes/$recipe_given.yaml and no such file" >&2; exit 2
+  fi
+fi
 [ -n "$hosts" ] && hosts=$(abs "$hosts")
 build=${MASA_BUILD_DIR:-build}
 [ -x "$build/tools/masa_train" ] || { echo "grid.sh: $build/tools/masa_train is missing: run scripts/build.sh first" >&2; exit 2; }
@@ -119,12 +130,15 @@ if [ -n "$out" ] && [ -f "$out/grid.txt" ]; then
   if [ ${#sets[@]} -gt 0 ] && [ "$(printf '%s\n' "${sets[@]}")" != "$g_sets" ]; then
     echo "grid.sh: $out was made with other --set options:"$'\n'"$g_sets" >&2; exit 2
   fi
+  if [ -n "$recipe_given" ] && [ "$recipe_given" != "$g_recipe" ]; then
+    echo "grid.sh: $out was made with recipe=$g_recipe, not '$recipe_given' (1: each task's own, 0: none)" >&2; exit 2
+  fi
   tasks=${tasks:-$g_tasks} methods=${methods:-$g_methods} seeds=${seeds:-$g_seeds} updates=$g_updates recipe=$g_recipe
   mapfile -t sets < <(printf '%s' "$g_sets" | sed '/^$/d')
 elif [ "$replot" = 1 ] || [ "$status" = 1 ]; then
   echo "grid.sh: --replot and --status need --out with an existing grid (its grid.txt)" >&2; exit 2
 else
-  tasks=${tasks:-a1_beam} methods=${methods:-masa sa} seeds=${seeds:-0}
+  tasks=${tasks:-a1_beam} methods=${methods:-masa sa} seeds=${seeds:-0} recipe=${recipe_given:-1}
   out=${out:-experiments/results/grid_$(date +%Y%m%d_%H%M%S)}
   mkdir -p "$out"
   { echo "tasks=$tasks"; echo "methods=$methods"; echo "seeds=$seeds"; echo "updates=$updates"
@@ -135,6 +149,15 @@ else
   milestones=()
 fi
 out=$(cd "$out" && pwd)
+# The recipe file of task $1's runs, or nothing.
+recipe_file() {
+  case "$recipe" in
+    0) ;;
+    1) [ ! -f "configs/recipes/$1.yaml" ] || echo "configs/recipes/$1.yaml" ;;
+    /*) echo "$recipe" ;;
+    *) echo "configs/recipes/$recipe.yaml" ;;
+  esac
+}
 
 # --status: every run's updates against its target, its last evaluation return (the policy mean's,
 # runner.eval_every), and the grid's ETA from each method's recent
@@ -150,7 +173,7 @@ if [ "$status" = 1 ]; then
     dir="$out/$t/${m}_s$sd" target=$updates
     # max_epochs: the key's name in run directories made before issue #32
     [ -n "$target" ] || target=$(sed -n 's/^ *max_\(updates\|epochs\): *\([0-9]*\).*/\2/p' "$dir/config.yaml" 2>/dev/null | head -1)
-    [ -n "$target" ] || target=$(sed -n 's/^ *max_updates: *\([0-9]*\).*/\1/p' "configs/recipes/$t.yaml" 2>/dev/null | head -1)
+    [ -n "$target" ] || target=$(sed -n 's/^ *max_updates: *\([0-9]*\).*/\1/p' "$(recipe_file "$t")" 2>/dev/null | head -1)
     state=waiting
     if [ -f "$dir/done" ]; then state=done
     elif [ -f "$dir/metrics.csv" ]; then
@@ -267,7 +290,7 @@ if [ "$replot" = 0 ]; then
     else
       rm -rf "$dir"
       args+=(--run-dir "$dir")
-      [ "$recipe" = 1 ] && [ -f "configs/recipes/$t.yaml" ] && args+=(--recipe "$t")
+      local r; r=$(recipe_file "$t"); [ -z "$r" ] || args+=(--recipe "$r")
       args+=(--set task="$t" --set method="$m" --set seed="$s")
       while IFS= read -r x; do [ -n "$x" ] && args+=(--set "$x"); done <<< "$MASA_GRID_SETS"
     fi
@@ -308,7 +331,7 @@ if [ "$replot" = 0 ]; then
       run_one "$host" $line
     done
   }
-  export -f run_one worker pop_job
+  export -f run_one worker pop_job recipe_file
   for t in $tasks; do mkdir -p "$out/$t"; done
   pids=()
   # On a kill: the workers (no new runs) and their runs, which checkpoint and exit; the grid exits
