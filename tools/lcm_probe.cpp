@@ -86,124 +86,106 @@ struct ChannelLog {
   int64_t first_us = 0, last_us = 0;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"Report message counts, sizes, rates and publication-to-reception latency on masa's LCM channels"};
-  app.set_version_flag("--version", masa::buildCommit());
+struct ProbeArgs {
   std::string url = transport::loopbackUrl();
   std::vector<std::string> channels;
-  bool all = false, quiet = false;
+  bool quiet = false;
   double duration_s = 0.0;
   int64_t max_count = 0, run_id = 0;
-  std::string csv_path;
-  app.add_option("--url", url, "LCM provider URL")->capture_default_str();
-  app.add_option("--channel", channels, "channel to listen on (repeatable; default MASA_POLICY)");
+  std::string csv_path, key_file, roster_file;
+};
+
+// Parses the command line; returns an exit code when the program should end now, or -1 to go on.
+int parseArgs(int argc, char** argv, ProbeArgs& a) {
+  CLI::App app{"Report message counts, sizes, rates and publication-to-reception latency on masa's LCM channels"};
+  app.set_version_flag("--version", masa::buildCommit());
+  bool all = false;
+  app.add_option("--url", a.url, "LCM provider URL")->capture_default_str();
+  app.add_option("--channel", a.channels, "channel to listen on (repeatable; default MASA_POLICY)");
   app.add_flag("--all", all, "listen on all four masa channels");
-  app.add_option("--duration", duration_s, "stop after this many seconds (0: until Ctrl-C or --count)")
+  app.add_option("--duration", a.duration_s, "stop after this many seconds (0: until Ctrl-C or --count)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--count", max_count, "stop after this many messages in all (0: no limit)")->check(CLI::NonNegativeNumber);
-  app.add_option("--run-id", run_id, "count only messages of this run (0: any run)");
-  app.add_option("--csv", csv_path, "write one row per message: channel,recv_us,utime,latency_us,bytes,version");
-  app.add_flag("--quiet", quiet, "print the summary only, not one line per message");
-  std::string key_file, roster_file;
+  app.add_option("--count", a.max_count, "stop after this many messages in all (0: no limit)")->check(CLI::NonNegativeNumber);
+  app.add_option("--run-id", a.run_id, "count only messages of this run (0: any run)");
+  app.add_option("--csv", a.csv_path, "write one row per message: channel,recv_us,utime,latency_us,bytes,version");
+  app.add_flag("--quiet", a.quiet, "print the summary only, not one line per message");
   auto* key_opt =
-      app.add_option("--key-file", key_file, "the run's run.key: count only messages with a valid tag (default: tags unchecked)");
-  app.add_option("--roster", roster_file,
+      app.add_option("--key-file", a.key_file, "the run's run.key: count only messages with a valid tag (default: tags unchecked)");
+  app.add_option("--roster", a.roster_file,
                  "a signed run's RUN_DIR/roster: count only messages whose signature, sender, channel and counter "
                  "verify (no key needed)")
       ->excludes(key_opt);
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
   if (all)
-    channels = {transport::kPolicyChannel, transport::kLearnerStatsChannel, transport::kHeartbeatChannel,
-                transport::kRolloutChannel};
-  if (channels.empty()) channels = {transport::kPolicyChannel};
+    a.channels = {transport::kPolicyChannel, transport::kLearnerStatsChannel, transport::kHeartbeatChannel,
+                  transport::kRolloutChannel};
+  if (a.channels.empty()) a.channels = {transport::kPolicyChannel};
+  return -1;
+}
 
-  std::ofstream csv;
-  if (!csv_path.empty()) {
-    csv.open(csv_path);
-    if (!csv) {
-      std::fprintf(stderr, "masa_lcm_probe: cannot write %s\n", csv_path.c_str());
-      return 2;
-    }
-    csv << "channel,recv_us,utime,latency_us,bytes,version\n";
+// What the probe heard, per channel, and the CSV row of each message.
+class ProbeRecorder {
+ public:
+  ProbeRecorder(const ProbeArgs& a, std::ofstream& csv) : a_(a), csv_(csv) {
+    for (const std::string& ch : a.channels) logs_[ch];
   }
 
-  std::map<std::string, ChannelLog> logs;
-  int64_t total = 0;
-  try {
-    std::optional<transport::RunKey> key;
-    if (!key_file.empty()) key = transport::readRunKey(key_file);
-    const bool checked = key || !roster_file.empty();
-    std::unique_ptr<transport::Transport> owned =
-        roster_file.empty() ? std::make_unique<transport::Transport>(url, key)
-                            : std::make_unique<transport::Transport>(
-                                  url, transport::SignedMode{nullptr, std::make_shared<const transport::Roster>(
-                                                                          transport::Roster::load(roster_file))});
-    transport::Transport& bus = *owned;
-    if (!bus.recvBufCheck().sufficient) std::fprintf(stderr, "masa_lcm_probe: %s\n", bus.recvBufCheck().message.c_str());
-    for (const std::string& ch : channels) {
-      logs[ch];
-      bus.subscribeRaw(ch, [&, ch](const void* data, int size) {
-        const int64_t now = transport::wallClockMicros();  // first: decoding is not the network's time
-        if (!checked) size = transport::sizeBeforeTrailer(data, size);
-        const auto stamp = readStamp(ch, data, size);
-        if (stamp && run_id != 0 && stamp->run_id != run_id) return;
-        ChannelLog& log = logs[ch];
-        if (log.messages == 0) log.first_us = now;
-        log.last_us = now;
-        ++log.messages;
-        ++total;
-        log.bytes += size;
-        log.sizes.push_back(size);
-        double latency_us = -1.0;
-        if (stamp) {
-          latency_us = static_cast<double>(now - stamp->utime);
-          log.latencies_ms.push_back(latency_us / 1000.0);
-          if (ch == transport::kPolicyChannel) ++log.versions[stamp->version];
-        } else if (ch != transport::kRolloutChannel) {
-          ++log.undecoded;
-        }
-        if (csv.is_open())
-          csv << ch << ',' << now << ',' << (stamp ? stamp->utime : 0) << ',' << latency_us << ',' << size << ','
-              << (stamp ? stamp->version : -1) << '\n';
-        if (!quiet && stamp)
-          std::printf("%s  %d B  version/id %lld  latency %.3f ms\n", ch.c_str(), size,
-                      static_cast<long long>(stamp->version), latency_us / 1000.0);
-      });
+  // One message received at `now` (wall clock, microseconds), its trailer already set aside.
+  void record(const std::string& ch, const void* data, int size, int64_t now) {
+    const auto stamp = readStamp(ch, data, size);
+    if (stamp && a_.run_id != 0 && stamp->run_id != a_.run_id) return;
+    ChannelLog& log = logs_[ch];
+    if (log.messages == 0) log.first_us = now;
+    log.last_us = now;
+    ++log.messages;
+    ++total_;
+    log.bytes += size;
+    log.sizes.push_back(size);
+    double latency_us = -1.0;
+    if (stamp) {
+      latency_us = static_cast<double>(now - stamp->utime);
+      log.latencies_ms.push_back(latency_us / 1000.0);
+      if (ch == transport::kPolicyChannel) ++log.versions[stamp->version];
+    } else if (ch != transport::kRolloutChannel) {
+      ++log.undecoded;
     }
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
-    std::fprintf(stderr, "masa_lcm_probe: listening on %s; %s\n", url.c_str(),
-                 key ? ("tags checked with run key id " + key->id()).c_str()
-                 : !roster_file.empty() ? ("signatures checked against the roster " + roster_file).c_str()
-                                        : "tags not checked (no --key-file or --roster)");
-    const auto start = std::chrono::steady_clock::now();
-    while (!g_stop.load()) {
-      if (bus.handleTimeout(100) < 0) {
-        if (g_stop.load()) break;  // the signal interrupted the wait: a normal end
-        std::fprintf(stderr, "masa_lcm_probe: LCM error while receiving\n");
-        return 1;
-      }
-      if (max_count > 0 && total >= max_count) break;
-      if (duration_s > 0 &&
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= duration_s)
-        break;
-    }
-    for (auto& [ch, log] : logs) {
-      if (roster_file.empty()) {
+    if (csv_.is_open())
+      csv_ << ch << ',' << now << ',' << (stamp ? stamp->utime : 0) << ',' << latency_us << ',' << size << ','
+           << (stamp ? stamp->version : -1) << '\n';
+    if (!a_.quiet && stamp)
+      std::printf("%s  %d B  version/id %lld  latency %.3f ms\n", ch.c_str(), size, static_cast<long long>(stamp->version),
+                  latency_us / 1000.0);
+  }
+
+  // The transport's refusals per channel: with a run key, messages without a valid tag; with a
+  // roster, every reason a signed run refuses for (signature, sender, channel, claim, counter).
+  void countRefusals(transport::Transport& bus) {
+    for (auto& [ch, log] : logs_) {
+      if (a_.roster_file.empty()) {
         log.unauthenticated = bus.rejected(ch)[static_cast<int>(transport::WireVerdict::kUnauthenticated)];
-      } else {  // every reason a signed run refuses for: signature, sender, channel, claim, counter
+      } else {
         for (int64_t n : bus.rejected(ch)) log.unauthenticated += n;
       }
     }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "masa_lcm_probe: %s\n", e.what());
-    return 2;
   }
 
+  int64_t total() const { return total_; }
+  void printSummary();
+
+ private:
+  const ProbeArgs& a_;
+  std::ofstream& csv_;
+  std::map<std::string, ChannelLog> logs_;
+  int64_t total_ = 0;
+};
+
+void ProbeRecorder::printSummary() {
   std::printf("channel               count   rate/s    MB/s  bytes(median)  bytes(max)  latency ms: median     p99     max\n");
-  for (auto& [ch, log] : logs) {
+  for (auto& [ch, log] : logs_) {
     std::sort(log.sizes.begin(), log.sizes.end());
     std::sort(log.latencies_ms.begin(), log.latencies_ms.end());
     const double span_s = (log.last_us - log.first_us) / 1e6;
@@ -229,9 +211,77 @@ int main(int argc, char** argv) {
       std::printf("  %s: %lld messages did not decode as the channel's type\n", ch.c_str(),
                   static_cast<long long>(log.undecoded));
     if (log.unauthenticated > 0)
-      std::printf(roster_file.empty() ? "  %s: %lld messages without a valid tag of the run key, not counted above\n"
-                                      : "  %s: %lld messages refused by the roster's checks, not counted above\n",
+      std::printf(a_.roster_file.empty() ? "  %s: %lld messages without a valid tag of the run key, not counted above\n"
+                                         : "  %s: %lld messages refused by the roster's checks, not counted above\n",
                   ch.c_str(), static_cast<long long>(log.unauthenticated));
   }
+}
+
+// The bus the probe listens on: plain, checking a run key's tags, or verifying a roster's signatures.
+std::unique_ptr<transport::Transport> openBus(const ProbeArgs& a, const std::optional<transport::RunKey>& key) {
+  if (a.roster_file.empty()) return std::make_unique<transport::Transport>(a.url, key);
+  return std::make_unique<transport::Transport>(
+      a.url, transport::SignedMode{nullptr, std::make_shared<const transport::Roster>(transport::Roster::load(a.roster_file))});
+}
+
+// Receives until a signal, --count or --duration; false on an LCM error.
+bool listen(const ProbeArgs& a, transport::Transport& bus, const ProbeRecorder& recorder) {
+  const auto start = std::chrono::steady_clock::now();
+  while (!g_stop.load()) {
+    if (bus.handleTimeout(100) < 0) {
+      if (g_stop.load()) break;  // the signal interrupted the wait: a normal end
+      std::fprintf(stderr, "masa_lcm_probe: LCM error while receiving\n");
+      return false;
+    }
+    if (a.max_count > 0 && recorder.total() >= a.max_count) break;
+    if (a.duration_s > 0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= a.duration_s)
+      break;
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ProbeArgs a;
+  if (const int code = parseArgs(argc, argv, a); code >= 0) return code;
+
+  std::ofstream csv;
+  if (!a.csv_path.empty()) {
+    csv.open(a.csv_path);
+    if (!csv) {
+      std::fprintf(stderr, "masa_lcm_probe: cannot write %s\n", a.csv_path.c_str());
+      return 2;
+    }
+    csv << "channel,recv_us,utime,latency_us,bytes,version\n";
+  }
+
+  ProbeRecorder recorder(a, csv);
+  try {
+    std::optional<transport::RunKey> key;
+    if (!a.key_file.empty()) key = transport::readRunKey(a.key_file);
+    const bool checked = key || !a.roster_file.empty();
+    std::unique_ptr<transport::Transport> bus = openBus(a, key);
+    if (!bus->recvBufCheck().sufficient) std::fprintf(stderr, "masa_lcm_probe: %s\n", bus->recvBufCheck().message.c_str());
+    for (const std::string& ch : a.channels) {
+      bus->subscribeRaw(ch, [&, ch](const void* data, int size) {
+        const int64_t now = transport::wallClockMicros();  // first: decoding is not the network's time
+        if (!checked) size = transport::sizeBeforeTrailer(data, size);
+        recorder.record(ch, data, size, now);
+      });
+    }
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    std::fprintf(stderr, "masa_lcm_probe: listening on %s; %s\n", a.url.c_str(),
+                 key ? ("tags checked with run key id " + key->id()).c_str()
+                 : !a.roster_file.empty() ? ("signatures checked against the roster " + a.roster_file).c_str()
+                                          : "tags not checked (no --key-file or --roster)");
+    if (!listen(a, *bus, recorder)) return 1;
+    recorder.countRefusals(*bus);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "masa_lcm_probe: %s\n", e.what());
+    return 2;
+  }
+  recorder.printSummary();
   return 0;
 }
