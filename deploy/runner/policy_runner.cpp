@@ -81,6 +81,8 @@ PolicyRunner::PolicyRunner(policy::LoadedPolicy& policy, const DeployConfig& con
   const double period_s = cfg_.control_rate_hz > 0 ? 1.0 / cfg_.control_rate_hz : task_->controlTimestep();
   period_us_ = std::max<int64_t>(1, std::llround(period_s * 1e6));
   stale_us_ = std::max<int64_t>(1, std::llround(cfg_.stale_after_s * 1e6));
+  // A forged lead shorter than half the stale time cannot starve the watchdog of real states.
+  freshness_ = StateFreshness(stale_us_ / 2);
   settle_commands_ = static_cast<int>(std::ceil(cfg_.calibration_settle_s / period_s - 1e-9));
   // The weights never change on the robot: frozen, inference reads them packed for its agent
   // columns. One inference now, so that the packs and buffers exist before the first command.
@@ -123,8 +125,9 @@ void PolicyRunner::onState(const masa::lcmt_robot_state& s, int64_t rx_us) {
     ++states_ignored_;
     return;
   }
-  if (have_state_ && s.utime <= state_utime_) {  // a repeat of an old state is no news
-    ++states_ignored_;
+  const StateFreshness::Verdict news = freshness_.judge(s.utime, rx_us);
+  if (news == StateFreshness::Verdict::kRepeat || news == StateFreshness::Verdict::kAhead) {
+    ++states_ignored_;  // a repeat of an old state, or a utime ahead of the clock: no news
     return;
   }
   ++states_received_;

@@ -16,7 +16,8 @@
 // Every command, in every mode, passes the limits: targets inside the model's joint range less a
 // margin, at most max_target_rate per second away from the previous target (policy mode), gains
 // and feed-forward torques within their bounds.
-// Watchdog: no new state (utime advancing) for stale_after_s gives the safe command by
+// Watchdog: no new state (utime advancing, deploy/runner/state_freshness.hpp) for stale_after_s
+// gives the safe command by
 //   last state + stale_after_s + one period   (watchdogBoundS());
 // a non-finite state (or policy output) gives it at once. Nothing allocates after construction.
 #pragma once
@@ -32,6 +33,7 @@
 #include "common/policy/policy_file.hpp"
 #include "common/sim/registry.hpp"
 #include "deploy/runner/deploy_config.hpp"
+#include "deploy/runner/state_freshness.hpp"
 #include "masa/lcmt_robot_command.hpp"
 #include "masa/lcmt_robot_state.hpp"
 
@@ -93,6 +95,8 @@ class PolicyRunner {
   bool hasState() const { return have_state_; }
   int64_t statesReceived() const { return states_received_; }
   int64_t statesIgnored() const { return states_ignored_; }
+  // Whether each state was news (its utime against the receive clock): refusals and resyncs.
+  const StateFreshness& freshness() const { return freshness_; }
 
  private:
   void trip(Mode m, std::string why);
@@ -121,6 +125,7 @@ class PolicyRunner {
   bool has_base_ = false;
   std::string nonfinite_field_;
   int64_t states_received_ = 0, states_ignored_ = 0;
+  StateFreshness freshness_;  // its lead: half the watchdog's stale_after_s
 
   // Commands.
   Mode mode_ = Mode::kCalibrating;

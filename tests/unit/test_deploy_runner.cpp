@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "common/transport/message_mutator.hpp"
+#include "common/transport/wire_guard.hpp"
 #include "common/core/config_error.hpp"
 #include "common/policy/policy_file.hpp"
 #include "deploy/runner/deploy_config.hpp"
@@ -178,6 +180,65 @@ TEST(DeployRunner, RepeatedStateIsStaleToo) {
   }
   ASSERT_GT(safe_at, 0);
   EXPECT_LE(safe_at - 995000, static_cast<int64_t>(r.watchdogBoundS() * 1e6));
+}
+
+// docs/inputs.md gap 2: one state with a far-future utime, from anyone on the robot's LAN, made
+// every later real state a "repeat", and the watchdog latched the safe command.
+TEST(DeployRunner, OneForgedFarFutureStateDoesNotStopTheRobot) {
+  Fixture f;
+  PolicyRunner r(f.lp, testConfig(), 1);
+  int64_t utime = 0;
+  drive(r, *f.sim, 0, 1500000, 5000, utime);
+  ASSERT_EQ(r.mode(), Mode::kPolicy);
+  r.onState(stateOf(*f.sim, std::numeric_limits<int64_t>::max() - 1), 1502500);
+  const int64_t taken = r.statesReceived();
+  auto sent = drive(r, *f.sim, 1500000, 2500000, 5000, utime);
+  ASSERT_FALSE(sent.empty());
+  for (const Sent& s : sent) ASSERT_EQ(s.c.mode, static_cast<int>(Mode::kPolicy)) << "safe command at " << s.t << ": " << r.reason();
+  EXPECT_EQ(r.statesReceived() - taken, 200) << "the real states after the forgery were not all taken";
+  EXPECT_EQ(r.freshness().refusedAhead(), 1);
+}
+
+// docs/inputs.md gap 2: mutated copies of the robot's real state messages (bit flips, hostile
+// lengths, truncation, splices), through the wire guard into the runner, interleaved with the real
+// ones: no crash, and every command finite and within the joint range and the gain bounds.
+TEST(DeployRunner, MutatedStateMessagesNeverGiveACommandOutsideTheLimits) {
+  Fixture f;
+  PolicyRunner r(f.lp, testConfig(), 1);
+  const DeployConfig c = testConfig();
+  int64_t utime = 0, delivered = 0, refused = 0;
+  masa::lcmt_robot_command cmd = r.makeCommand();
+  masa::lcmt_robot_state decoded;
+  for (int64_t t = 0; t < 3000000; t += 500) {
+    if (t % 5000 == 0) {
+      const masa::lcmt_robot_state real = stateOf(*f.sim, ++utime);
+      std::vector<uint8_t> bytes(static_cast<std::size_t>(real.getEncodedSize()));
+      real.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+      r.onState(real, t);
+      transport::MessageMutator mutator(bytes, static_cast<uint64_t>(utime));
+      for (int m = 0; m < 3; ++m) {
+        const std::vector<uint8_t> hostile = mutator.next();
+        if (transport::decodeChecked(hostile.data(), static_cast<int>(hostile.size()), decoded) != transport::WireVerdict::kOk) {
+          ++refused;
+          continue;
+        }
+        ++delivered;
+        r.onState(decoded, t + 100 + m);
+      }
+    }
+    if (!r.poll(t, cmd)) continue;
+    for (int k = 0; k < r.numJoints(); ++k) {
+      ASSERT_TRUE(std::isfinite(cmd.position[k]) && std::isfinite(cmd.velocity[k]) && std::isfinite(cmd.torque_ff[k]));
+      ASSERT_GE(cmd.position[k], r.lowerLimit()[k]) << "joint " << k << " at " << t;
+      ASSERT_LE(cmd.position[k], r.upperLimit()[k]) << "joint " << k << " at " << t;
+      ASSERT_LE(std::abs(cmd.torque_ff[k]), r.torqueLimit()[k]);
+      ASSERT_TRUE(cmd.kp[k] >= 0.0 && cmd.kp[k] <= c.max_kp && cmd.kd[k] >= 0.0 && cmd.kd[k] <= c.max_kd);
+    }
+  }
+  EXPECT_GT(refused, 0) << "no mutation was refused by the wire guard";
+  EXPECT_GT(delivered, 0) << "no mutation decoded: the runner was not reached";
+  std::printf("robot state fuzz: %lld mutations decoded and given to the runner, %lld refused by the guard; mode %s\n",
+              static_cast<long long>(delivered), static_cast<long long>(refused), modeName(r.mode()));
 }
 
 TEST(DeployRunner, NonFiniteStateGivesTheSafeCommandAtOnce) {
