@@ -1,9 +1,12 @@
 // A default is stated in the defaults file (configs/defaults.yaml, configs/deploy/defaults.yaml: the
-// schema) and again in the struct's member initializers, which code that builds a config by hand
-// uses. The two must not drift: reading the defaults file alone gives the struct's defaults.
+// schema, the one place a user reads and changes them) and mirrored in the structs' member
+// initializers, which code that builds a config by hand uses. Every config (run, sac, offline,
+// deploy) is held to its file here: reading the defaults file alone gives the struct's defaults.
 #include <gtest/gtest.h>
 
 #include <string>
+
+#include <yaml-cpp/yaml.h>
 
 #include "deploy/runner/deploy_config.hpp"
 #include "learner/offline/offline_config.hpp"
@@ -13,6 +16,30 @@ namespace masa {
 namespace {
 
 #define EXPECT_SAME(field) EXPECT_EQ(read.field, fresh.field) << #field
+
+// The run config (ppo, runner, model, method, seed, learner) from the defaults file alone: the
+// middle layer is a tree that names only the task, so no task file sets a key.
+TEST(ConfigDefaults, TheRunStructIsTheDefaultsFile) {
+  const config::RunConfig read = config::loadRunConfigOver(std::string(MASA_SOURCE_DIR) + "/configs", {},
+                                                           YAML::Load("task: a1_beam"), "the test"),
+                          fresh;
+  EXPECT_SAME(method); EXPECT_SAME(seed); EXPECT_SAME(learner);
+  EXPECT_SAME(ppo.num_envs); EXPECT_SAME(ppo.horizon); EXPECT_SAME(ppo.minibatch_size); EXPECT_SAME(ppo.mini_epochs);
+  EXPECT_SAME(ppo.learning_rate); EXPECT_SAME(ppo.lr_schedule); EXPECT_SAME(ppo.kl_threshold); EXPECT_SAME(ppo.lr_min);
+  EXPECT_SAME(ppo.lr_max); EXPECT_SAME(ppo.gamma); EXPECT_SAME(ppo.tau); EXPECT_SAME(ppo.e_clip);
+  EXPECT_SAME(ppo.entropy_coef); EXPECT_SAME(ppo.critic_coef); EXPECT_SAME(ppo.bounds_loss_coef);
+  EXPECT_SAME(ppo.soft_bound); EXPECT_SAME(ppo.grad_norm); EXPECT_SAME(ppo.normalize_value);
+  EXPECT_SAME(ppo.normalize_advantage); EXPECT_SAME(ppo.value_bootstrap); EXPECT_SAME(ppo.max_updates);
+  EXPECT_SAME(ppo.max_policy_lag);
+  EXPECT_SAME(runner.checkpoint_every); EXPECT_SAME(runner.republish_every_s); EXPECT_SAME(runner.plot_every);
+  EXPECT_SAME(runner.eval_every); EXPECT_SAME(runner.eval_episodes); EXPECT_SAME(runner.silence_warn_s);
+  EXPECT_SAME(runner.rank_silence_stop_s); EXPECT_SAME(runner.snapshot_every); EXPECT_SAME(runner.min_batch_fraction);
+  EXPECT_SAME(runner.loss_grace_s); EXPECT_SAME(runner.repeat_unacknowledged_s);
+  EXPECT_SAME(model.method); EXPECT_SAME(model.policy_hidden); EXPECT_SAME(model.critic_hidden);
+  EXPECT_SAME(model.critic_head_hidden); EXPECT_SAME(model.activation); EXPECT_SAME(model.init_log_std);
+  EXPECT_SAME(model.policy_last_layer_scale); EXPECT_SAME(model.sasa_policy_coef); EXPECT_SAME(model.sasa_value_coef);
+  EXPECT_SAME(model.normalize_obs);
+}
 
 // a1_beam's task file sets only ppo, runner, model and env keys, so sac and offline are the defaults'.
 config::RunConfig defaultsRun() {
