@@ -11,6 +11,9 @@
 // With --key-file (a run's run.key) only messages with a valid tag count, with --roster (a signed
 // run's roster) only messages whose signature, sender, channel and counter verify; the others are
 // reported by reason. Without either, a message's trailer is skipped unchecked (the probe only watches).
+// With --log FILE it reads a recording instead (lcm-logger's log, through LogBus): the same table,
+// each message's time being when the logger received it, so the latency is publication to logger.
+//   lcm-logger run.lcmlog & ... ; masa_lcm_probe --log run.lcmlog --all --quiet
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -29,6 +32,7 @@
 #include "common/core/build_info.hpp"
 #include "common/transport/channels.hpp"
 #include "common/transport/lcm_url.hpp"
+#include "common/transport/log_bus.hpp"
 #include "common/transport/message_auth.hpp"
 #include "common/transport/roster.hpp"
 #include "common/transport/run_key.hpp"
@@ -92,7 +96,7 @@ struct ProbeArgs {
   bool quiet = false;
   double duration_s = 0.0;
   int64_t max_count = 0, run_id = 0;
-  std::string csv_path, key_file, roster_file;
+  std::string csv_path, key_file, roster_file, log_path;
 };
 
 // Parses the command line; returns an exit code when the program should end now, or -1 to go on.
@@ -115,10 +119,16 @@ int parseArgs(int argc, char** argv, ProbeArgs& a) {
                  "a signed run's RUN_DIR/roster: count only messages whose signature, sender, channel and counter "
                  "verify (no key needed)")
       ->excludes(key_opt);
+  app.add_option("--log", a.log_path, "read this lcm-logger log instead of the network (its messages unverified)")
+      ->check(CLI::ExistingFile);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  }
+  if (!a.log_path.empty() && (!a.key_file.empty() || !a.roster_file.empty() || a.duration_s > 0)) {
+    std::fprintf(stderr, "masa_lcm_probe: --log replays a recording unverified and whole: no --key-file, --roster or --duration\n");
+    return 2;
   }
   if (all)
     a.channels = {transport::kPolicyChannel, transport::kLearnerStatsChannel, transport::kHeartbeatChannel,
@@ -240,6 +250,26 @@ bool listen(const ProbeArgs& a, transport::Transport& bus, const ProbeRecorder& 
   return true;
 }
 
+// Reads a recorded log to its end (or --count); false when the log is damaged (said why).
+bool replayLog(const ProbeArgs& a, ProbeRecorder& recorder) {
+  transport::LogBus bus(a.log_path);
+  for (const std::string& ch : a.channels) {
+    bus.subscribeRaw(ch, [&, ch](const void* data, int size) {
+      recorder.record(ch, data, transport::sizeBeforeTrailer(data, size), bus.eventTimeUs());
+    });
+  }
+  std::fprintf(stderr, "masa_lcm_probe: reading the log %s (tags and signatures not checked)\n", a.log_path.c_str());
+  int r;
+  while ((r = bus.handleTimeout(0)) > 0 && !g_stop.load())
+    if (a.max_count > 0 && recorder.total() >= a.max_count) break;
+  if (r < 0) {
+    std::fprintf(stderr, "masa_lcm_probe: %s\n", bus.error().c_str());
+    return false;
+  }
+  std::fprintf(stderr, "masa_lcm_probe: %lld events read from the log\n", static_cast<long long>(bus.events()));
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -257,6 +287,18 @@ int main(int argc, char** argv) {
   }
 
   ProbeRecorder recorder(a, csv);
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  if (!a.log_path.empty()) {
+    try {
+      if (!replayLog(a, recorder)) return 1;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "masa_lcm_probe: %s\n", e.what());
+      return 2;
+    }
+    recorder.printSummary();
+    return 0;
+  }
   try {
     std::optional<transport::RunKey> key;
     if (!a.key_file.empty()) key = transport::readRunKey(a.key_file);
@@ -270,8 +312,6 @@ int main(int argc, char** argv) {
         recorder.record(ch, data, size, now);
       });
     }
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
     std::fprintf(stderr, "masa_lcm_probe: listening on %s; %s\n", a.url.c_str(),
                  key ? ("tags checked with run key id " + key->id()).c_str()
                  : !a.roster_file.empty() ? ("signatures checked against the roster " + a.roster_file).c_str()

@@ -1,8 +1,9 @@
 // What actors and the learner need of a transport: typed and raw publish/subscribe on named
-// channels and a bounded wait that runs the handlers, with every rejected message counted. Two
+// channels and a bounded wait that runs the handlers, with every rejected message counted. Three
 // implementations: Transport (LCM, between processes or through memq://, every message encoded,
-// authenticated with a key or a signer, decoded through the wire guard) and LocalBus (one process,
-// a typed message handed to typed subscribers as it is, with no encoding).
+// authenticated with a key or a signer, decoded through the wire guard), LocalBus (one process,
+// a typed message handed to typed subscribers as it is, with no encoding) and LogBus (a LocalBus
+// that replays an lcm-logger recording, read-only).
 //
 // A channel given to subscribe is a regular expression matched against the whole channel name, as
 // LCM does. Threading: publish may be called from any thread; handle*() and (un)subscribe() from
