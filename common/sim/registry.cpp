@@ -50,9 +50,14 @@ TaskFactory::TaskFactory(const TaskCatalog& catalog, const std::string& name, co
   }
   make_ = info->make;
   std::string file = probe.text("model_file", info->model_file);
-  if (file.empty()) throw ConfigError(default_origin_, "env.model_file", "task '" + name + "' needs a model file");
-  if (!file.empty() && file[0] != '/') file = sourceRoot() + "/" + file;
-  model_ = MujocoModel::load(file);
+  // Errors name the file that chose the task code (a YAML task's file) or the model, not "configs".
+  if (file.empty()) throw ConfigError(probe.origin("task_code"), "env.model_file", "task '" + name + "' needs a model file");
+  if (file[0] != '/') file = sourceRoot() + "/" + file;
+  try {
+    model_ = MujocoModel::load(file);
+  } catch (const std::exception& e) {
+    throw ConfigError(probe.origin("model_file"), "env.model_file", e.what());
+  }
   // Building one task validates every parameter (and the spec's actuator names) up front.
   std::unique_ptr<Task> t = make_(model_, spec_, probe);
   probe.finish();

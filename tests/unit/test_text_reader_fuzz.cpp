@@ -22,68 +22,20 @@
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/run_key.hpp"
 #include "deploy/runner/deploy_config.hpp"
-#include "file_mutations.hpp"
+#include "damaged_text.hpp"
+#include "common/integrity/ed25519_keys.hpp"
+#include "common/sim/registry.hpp"
+#include "tasks/tasks.hpp"
 #include "learner/metrics_csv.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kConfigs = MASA_SOURCE_DIR "/configs";
-constexpr int kMutationsPerFile = 25;
-constexpr double kSecondsPerRead = 2.0;
-
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void writeAll(const fs::path& p, const std::string& bytes) {
-  std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
-}
-
-// A scratch copy of configs/ (and the models it points at stay where they are: paths in the
-// configs are relative to the source tree's configs' parent, so the copy sits beside a link).
-class DamagedText : public ::testing::Test {
- protected:
-  void SetUp() override {
-    root_ = fs::temp_directory_path() / ("masa_text_fuzz_" + std::to_string(::getpid()) + "_" +
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(root_);
-    fs::create_directories(root_);
-    fs::copy(kConfigs, root_ / "configs", fs::copy_options::recursive);
-    for (const char* linked : {"tasks", "tests"}) fs::create_directory_symlink(MASA_SOURCE_DIR "/" + std::string(linked), root_ / linked);
-  }
-  void TearDown() override { fs::remove_all(root_); }
-
-  // Mutates `file` kMutationsPerFile times (restoring it after each) and calls `read`: it must
-  // return or throw a std::exception whose message holds `name`, within the time bound.
-  void fuzz(const fs::path& file, const std::string& name, uint64_t seed, const std::function<void()>& read) {
-    const std::string original = readAll(file);
-    std::mt19937_64 rng(seed);
-    for (int i = 0; i < kMutationsPerFile; ++i) {
-      const masa::fuzz::FileMutation m = masa::fuzz::mutateFile(original, rng);
-      writeAll(file, m.bytes);
-      const auto t0 = std::chrono::steady_clock::now();
-      try {
-        read();
-        ++accepted_;
-      } catch (const std::exception& e) {
-        ++refused_;
-        EXPECT_NE(std::string(e.what()).find(name), std::string::npos)
-            << file.filename() << ", " << m.what << ": the error does not name the file: " << e.what();
-      }
-      EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), kSecondsPerRead)
-          << file.filename() << ", " << m.what;
-    }
-    writeAll(file, original);
-  }
-
-  fs::path root_;
-  int accepted_ = 0, refused_ = 0;
-};
+using masa::test::DamagedText;
+using masa::test::kMutationsPerFile;
+using masa::test::readAll;
+using masa::test::writeAll;
 
 TEST_F(DamagedText, TaskFilesAndRecipesAreReadWithinTheirChecksOrRefusedNamingTheFile) {
   const std::string configs = (root_ / "configs").string();
@@ -147,6 +99,41 @@ TEST_F(DamagedText, AMetricsFileIsCutAtTheCheckpointOrRefusedNamingIt) {
       EXPECT_TRUE(end != row.c_str() && *end == ',' && update <= 10) << "kept a row past the checkpoint: " << row;
     }
   });
+}
+
+// PEM keys (OpenSSL's reader behind SigningKey and TrustedKeys): a damaged key file is refused
+// naming it, or is still a key of its kind (a PEM body with a changed byte can be another valid key).
+TEST_F(DamagedText, KeyFilesAreKeysOfTheirKindOrRefusedNamingTheFile) {
+  const fs::path priv = root_ / "signer.key", pub = root_ / "signer.pub";
+  masa::integrity::generateKeyPair(priv.string(), pub.string());
+  fuzz(priv, priv.string(), 21, [&] {
+    ::chmod(priv.c_str(), 0600);
+    (void)masa::integrity::SigningKey::load(priv.string());
+  });
+  fuzz(pub, pub.string(), 22, [&] { (void)masa::integrity::TrustedKeys::load(pub.string()); });
+  EXPECT_GT(refused_, kMutationsPerFile);
+}
+
+// Tasks written in YAML (task_code: yaml; docs/yaml_task.md): the task file read and the task built
+// and stepped from its env section, as a training run does.
+TEST_F(DamagedText, YamlTasksAreBuiltWithinTheirChecksOrRefusedNamingTheFile) {
+  const std::string configs = (root_ / "configs").string();
+  uint64_t seed = 300;
+  for (const std::string task : {"a1_beam_yaml", "ant_acrobatic_yaml", "c4_walker"}) {
+    const fs::path file = root_ / "configs" / "tasks" / (task + ".yaml");
+    fuzz(file, task + ".yaml", seed++, [&] {
+      const masa::config::RunConfig rc = masa::config::loadRunConfig(configs, {"task=" + task});
+      const masa::task::TaskFactory factory(masa::task::taskCatalog(), task, masa::sym::SymmetrySpec::load(rc.spec_path),
+                                            rc.env, rc.origin);
+      std::unique_ptr<masa::task::Task> t = factory.create();
+      masa::Rng rng(1);
+      t->reset(rng);
+      const std::vector<float> zero(static_cast<std::size_t>(t->actDim()), 0.0f);
+      for (int k = 0; k < 5; ++k) (void)t->step(zero.data());
+    });
+  }
+  EXPECT_GT(refused_, 0);
+  EXPECT_GT(accepted_, 0);
 }
 
 }  // namespace
