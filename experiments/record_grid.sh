@@ -61,13 +61,15 @@ fi
 excludes=(--exclude=learning_curve.png --exclude=learning_curve.log
           --exclude=.grid.lock --exclude=.queue --exclude=.queue.lock --exclude=.slots)
 [ "$policies" = 1 ] || excludes+=(--exclude=policy.bin)
-[ "$checkpoints" -ge 1 ] || excludes+=(--exclude=checkpoint.bin --exclude=actor_state.bin)
+# off_policy_state.bin: an off-policy run's trainer and replay (about 110 MB for the A1 recipe), a
+# checkpoint like the others.
+[ "$checkpoints" -ge 1 ] || excludes+=(--exclude=checkpoint.bin --exclude=actor_state.bin --exclude=off_policy_state.bin)
 excludes+=(--exclude=actor_state.bin.tmp)
 [ -z "$kept_readme" ] || excludes+=(--exclude=./README.md)
 "$here/grid.sh" --status --out "$out" > "$to/status.txt"
 tar -C "$out" "${excludes[@]}" -cf - . | tar -C "$to" -xf -
 # A finished run's checkpoint only serves grid.sh --extend: kept when asked (--all-checkpoints).
-[ "$checkpoints" = 2 ] || find "$to" -mindepth 3 -maxdepth 3 -name done -execdir rm -f checkpoint.bin actor_state.bin \;
+[ "$checkpoints" = 2 ] || find "$to" -mindepth 3 -maxdepth 3 -name done -execdir rm -f checkpoint.bin actor_state.bin off_policy_state.bin \;
 # The environments (simulator states, doubles) halve under xz; restore_grid.sh unpacks them.
 if [ "$checkpoints" -ge 1 ]; then
   find "$to" -mindepth 3 -maxdepth 3 -name actor_state.bin -exec xz -6 -T1 {} + || \

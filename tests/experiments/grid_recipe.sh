@@ -2,6 +2,7 @@
 # experiments/grid.sh --recipe: every run of the grid is made from the one recipe named (here a
 # YAML file) instead of its task's, runs to that recipe's ppo.max_updates, and the grid remembers
 # it: a rerun naming another recipe is refused, a recipe that does not exist is refused up front.
+# The recipe is off-policy, so the record (record_grid.sh) is checked to leave its replay state out.
 #   tests/experiments/grid_recipe.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$(cd "$1" && pwd) work=$2
@@ -13,7 +14,9 @@ fail() { echo "FAIL: $*"; for f in grid/a1_beam/*.log grid*.out; do [ -f "$f" ] 
 cat > tiny.yaml <<'YAML'
 task: a1_beam
 method: masa
+learner: off_policy
 model: {policy_hidden: [16], critic_hidden: [16]}
+sac: {learning_starts: 64, batch_size: 32, policy_hidden: [16], q_hidden: [16], updates_per_step: 0.25}
 ppo: {num_envs: 8, horizon: 8, minibatch_size: 64, max_updates: 4}
 runner: {checkpoint_every: 2, eval_every: 2, eval_episodes: 1}
 env: {max_episode_steps: 40, velocity_reward: progress}
@@ -38,6 +41,11 @@ grep -qx "recipe=$work/tiny.yaml" grid/grid.txt || fail "grid.txt does not keep 
 "$src/experiments/grid.sh" --status --out grid > status.out 2>&1 || fail "--status failed"
 grep -Eq "a1_beam +masa +seed 0 +4/4 +done" status.out || fail "--status does not read the recipe's target: $(cat status.out)"
 
+# Recorded: the off-policy runs' replay state (off_policy_state.bin) stays out, as checkpoints do.
+ls grid/a1_beam/masa_s0/off_policy_state.bin > /dev/null 2>&1 || fail "the off-policy run wrote no off_policy_state.bin (the test needs one)"
+"$src/experiments/record_grid.sh" --out grid --to rec > rec.out 2>&1 || fail "record_grid.sh failed: $(cat rec.out)"
+[ -z "$(find rec -name off_policy_state.bin)" ] || fail "the record kept the replay state: $(find rec -name off_policy_state.bin)"
+[ -f rec/a1_beam/masa_s0/metrics.csv ] || fail "the record lacks the run's metrics"
 "$src/experiments/grid.sh" --recipe a1_beam --out grid > other.out 2>&1 && fail "a rerun with another recipe was accepted"
 grep -q "was made with recipe=" other.out || fail "the other recipe was not refused by name: $(cat other.out)"
 echo "PASS: grid.sh --recipe makes every run from the recipe and keeps it"
