@@ -30,13 +30,14 @@ class PolicyLagWindow {
   int64_t neededVersion() const;
 
   // Parameters of `version` arrived at now_s: the seconds since the end of the oldest unanswered
-  // rollout they answer, or nothing when they answer none.
+  // rollout they answer (or of an older one the actor stopped waiting for), or nothing when they
+  // answer none.
   std::optional<double> answer(int64_t version, double now_s);
 
  private:
   struct Sent {
-    int64_t answered_by;  // the version of the update that takes this rollout
-    double end_s;
+    int64_t answered_by;     // the version of the update that takes this rollout
+    double waiting_since_s;  // its end, or that of an older rollout whose answer never came
     bool answered;
   };
   int lag_;

@@ -54,6 +54,28 @@ TEST(PolicyLagWindow, LagZeroNeedsTheAnswerToTheLastRollout) {
   EXPECT_EQ(w.neededVersion(), 6);
 }
 
+// An actor that gave up waiting sends a rollout of the old version (the learner drops it). The
+// answer that comes after is timed from the end of the rollout the actor waited on, not from the
+// stale one: else a slow learner looks quick, the budget shrinks and every wait times out (found
+// on a 16-core machine: 15 actors, one learner core, 1000 dropped rollout chunks per update).
+TEST(PolicyLagWindow, AnAnswerAfterAWaitThatTimedOutIsTimedFromTheRolloutWaitedOn) {
+  PolicyLagWindow w(0);
+  w.sent(0, 1.0);  // waits for update 1 ...
+  w.sent(0, 3.0);  // ... gave up at 2.5 s, collected a stale rollout
+  const auto delay = w.answer(1, 4.0);
+  ASSERT_TRUE(delay);
+  EXPECT_DOUBLE_EQ(*delay, 3.0) << "the learner took 3 s since the first rollout's end, not 1 s";
+  // With the budget fed these answers, a learner that always takes 3 s is waited for after one miss.
+  masa::actor::AwaitBudget budget(1.0, 10.0);
+  budget.observeAnswer(*delay);
+  EXPECT_GE(budget.limitSeconds(), 3.0);
+  // A rollout that was answered leaves no trace on the next one's time.
+  w.sent(1, 5.0);
+  const auto next = w.answer(2, 5.5);
+  ASSERT_TRUE(next);
+  EXPECT_DOUBLE_EQ(*next, 0.5);
+}
+
 // Lag 1: one rollout may be unanswered when the next starts; the update that takes a rollout
 // comes after the one that takes the rollout before it.
 TEST(PolicyLagWindow, LagOneLetsOneRolloutBeUnansweredAndCountsTheUpdatesBeforeItsAnswer) {
