@@ -5,15 +5,17 @@
 # device time left can pay for a corrected try), then bench/scaling_device.sh under a time limit.
 # What comes back fits the device tool's limits (8 files, 2 folders deep): the tables as text and
 # everything else in one archive.
-#   bench/device_session.sh [--bundle DIR] [--limit SECONDS] [--out OUT]   (default .device, 470, $OUT)
+#   bench/device_session.sh [--bundle DIR] [--limit SECONDS] [--out OUT] [-- scaling_device.sh options]
+#                           (default .device, 470, $OUT)
 set -uo pipefail
 cd "$(dirname "$0")/.."
-bundle=.device limit=470 out=${OUT:-/tmp/masa_device_session}
+bundle=.device limit=470 out=${OUT:-/tmp/masa_device_session} pass=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --bundle) bundle=$2; shift 2 ;;
     --limit) limit=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
+    --) shift; pass=("$@"); break ;;
     *) echo "device_session.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
@@ -24,7 +26,7 @@ exec > >(tee -a "$log") 2>&1
 start=$SECONDS
 pack() {  # the archive of everything but checkpoints and environments, and the tables beside it
   tar -C "$work" --exclude='*.bin' --exclude='*.key' -czf "$out/scaling_device.tar.gz" . 2> /dev/null
-  for f in learner_ranks.txt actors.txt ranks.txt model.txt check/check.txt; do
+  for f in learner_ranks.txt actors.txt ranks.txt model.txt points.txt check/check.txt; do
     [ -f "$work/$f" ] && cp "$work/$f" "$out/$(basename "$f")"
   done
   echo "device_session.sh: $((SECONDS - start)) s; back: $(ls "$out" | tr '\n' ' ')"
@@ -58,6 +60,6 @@ if ! timeout 60 tests/mpi/mpirun.sh -np 2 -x OMP_NUM_THREADS=1 "$MASA_BUILD_DIR/
 fi
 
 echo "--- bench/scaling_device.sh, at most $limit s"
-timeout -k 10 "$limit" bench/scaling_device.sh --out "$work" || echo "device_session.sh: scaling_device.sh ended with status $? (124: the time limit)"
+timeout -k 10 "$limit" bench/scaling_device.sh --out "$work" "${pass[@]+"${pass[@]}"}" || echo "device_session.sh: scaling_device.sh ended with status $? (124: the time limit)"
 pkill -f masa_learner; pkill -f masa_actor; pkill -f orterun
 pack

@@ -10,14 +10,20 @@
 #  3. ranks.txt: training fps against learner ranks L = 1, 2, 4, 8 at 8 actors sharing 8 cores
 #  4. model.txt: the model beside every point of 2 and 3
 #  5. learner_ranks.txt: the learner's update with ranks x threads = C (a1_beam, humanoid_tightrope)
-#   bench/scaling_device.sh [--cores C] [--envs E] [--out OUT]      (MASA_BUILD_DIR: the build, default build)
+#   bench/scaling_device.sh [--cores C] [--envs E] [--updates N] [--warmup W] [--costs FILE] [--out OUT]
+#                           (MASA_BUILD_DIR: the build, default build)
+# --costs FILE: the costs.json of an earlier step 1 on the same machine: step 1 is skipped (its six
+# end-to-end points take minutes when one learner core serves 15 actors).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cores=$(nproc) envs=128 out=${OUT:-/tmp/masa_scaling_device}
+cores=$(nproc) envs=128 updates=16 warmup=5 costs="" out=${OUT:-/tmp/masa_scaling_device}
 while [ $# -gt 0 ]; do
   case "$1" in
     --cores) cores=$2; shift 2 ;;
     --envs) envs=$2; shift 2 ;;
+    --updates) updates=$2; shift 2 ;;
+    --warmup) warmup=$2; shift 2 ;;
+    --costs) costs=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     *) echo "scaling_device.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -26,14 +32,17 @@ mkdir -p "$out"
 machine=$(bash experiments/machine.sh 2> /dev/null || hostname)
 stamp() { echo "# $(date -u +%FT%TZ) $(git rev-parse --short HEAD 2> /dev/null || echo '?') on $machine: $*"; }
 
-bench/scaling_check.sh --cores "$cores" --envs "$envs" --out "$out/check"
-costs=$out/check/costs.json
+if [ -z "$costs" ]; then
+  bench/scaling_check.sh --cores "$cores" --envs "$envs" --out "$out/check"
+  costs=$out/check/costs.json
+fi
+[ -f "$costs" ] || { echo "scaling_device.sh: no costs file '$costs'" >&2; exit 2; }
 
 : > "$out/points.txt"
 run_on() {  # run_on CORES ACTORS RANKS LAG NAME: e2e_ranks.sh on the first CORES cores
   local c=$1 a=$2 l=$3 lag=$4 line fps
   line=$(taskset -c "0-$((c - 1))" bench/e2e_ranks.sh a1_beam --ranks "$l" --actors "$a" --envs "$envs" \
-    --updates 16 --warmup 5 --lag "$lag" --out "$out/$5") || true
+    --updates "$updates" --warmup "$warmup" --lag "$lag" --out "$out/$5") || true
   fps=$(sed -n 's/.*: fps \([0-9.]*\) (wall clock.*/\1/p' <<< "$line")
   echo "$line (on $c cores)"
   [ -n "$fps" ] && echo "fps $fps $a $envs 24 $l 1 $c $lag" >> "$out/points.txt"
