@@ -4,20 +4,22 @@
 # programs, every shared library they load that is not the C/C++ runtime, and a relocatable copy of
 # Debian's Open MPI (mpirun, its components, PMIx and their libraries, help texts). On the machine,
 # `source DIR/env.sh` points PATH, LD_LIBRARY_PATH, Open MPI and PMIx at the folder and sets
-# MASA_BUILD_DIR; tests/integration/device_bundle.sh runs a 2-rank job from it with the system's
+# MASA_BUILD_DIR; tests/integration/device_bundle.sh trains with 2 ranks from it with the system's
 # copies hidden.
-#   bench/device_bundle.sh [--build BUILD] [--out DIR]     (default: build, .device)
+#   bench/device_bundle.sh [--build BUILD] [--out DIR] [--programs "PATH ..."]   (default: build, .device,
+#                          the four programs of scaling_device.sh, paths inside BUILD)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build out=.device
+programs=(learner/masa_learner actors/masa_actor bench/bench_learner_ranks bench/bench_efficiency_bound)
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
+    --programs) read -r -a programs <<< "$2"; shift 2 ;;
     *) echo "device_bundle.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
-programs=(learner/masa_learner actors/masa_actor bench/bench_learner_ranks bench/bench_efficiency_bound)
 for p in "${programs[@]}"; do
   [ -x "$build/$p" ] || { echo "device_bundle.sh: $build/$p is missing (scripts/build.sh, bench/build_benchmarks.sh)" >&2; exit 2; }
 done
