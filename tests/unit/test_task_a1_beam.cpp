@@ -160,6 +160,38 @@ TEST(A1BeamReward, TheProgressFormPaysNothingForStandingAndTheFullTermAtTheTarge
   }
 }
 
+// Under the progress form any speed above the target pays in full, and the TD3 grid's MASA policies
+// settled at 0.55-0.80 m/s (experiments/results/a1_beam_td3_grid_2026-12-04). The tent pays the
+// most at the target and less on either side: half at half and at one and a half times the target,
+// nothing for standing and at twice the target.
+TEST(A1BeamReward, TheTentFormPaysMostAtTheTargetAndLessOnEitherSide) {
+  const double quat[4] = {1, 0, 0, 0};
+  double at_target = 0, above = 0;
+  for (const double vx : {0.0, 0.25, 0.5, 0.75, 1.0, 1.3, -0.8}) {
+    const TaskFactory f = runConfigFactory(kTask, {"env.velocity_reward=tent", "env.weights.velocity=2.0"});
+    auto t = f.create();
+    Rng rng(3);
+    t->reset(rng);
+    const double lin[3] = {vx, 0.0, 0.0};
+    setTrunk(*t, 0.0, 0.0, t->data()->qpos[2], quat, lin);
+    std::vector<float> zero(t->actDim(), 0.0f);
+    ASSERT_FALSE(t->step(zero.data()).terminated);
+    const double v = t->data()->qvel[0];  // after the step
+    const double expected = v <= 0.5 ? std::max(v / 0.5, -1.0) : std::max(2.0 - v / 0.5, 0.0);
+    EXPECT_DOUBLE_EQ(rewardTerm(*t, "velocity"), 2.0 * expected) << "v_x " << vx;
+    if (vx == 0.5) at_target = rewardTerm(*t, "velocity");
+    if (vx == 0.75) above = rewardTerm(*t, "velocity");
+  }
+  EXPECT_GT(at_target, 1.9) << "the full term near the target";
+  EXPECT_NEAR(above, 1.0, 0.1) << "half of it at 1.5 times the target (the progress form pays all of it)";
+  try {
+    runConfigFactory(kTask, {"env.velocity_reward=tent", "env.target_velocity=0"});
+    ADD_FAILURE() << "a tent around 0 m/s was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("env.target_velocity"), std::string::npos) << e.what();
+  }
+}
+
 TEST(A1BeamTermination, FallingBelowTheBeamEndsWithExactlyMinusOne) {
   const TaskFactory f = runConfigFactory(kTask);
   auto t = f.create();
