@@ -272,12 +272,15 @@ echo "train.sh: $task / $method over $url, $actors actors on ${#hosts[@]} hosts 
 # a command line: `ps` shows those), to the same path under MASA_REMOTE_DIR, mode 0600. Written
 # under a temporary name and renamed: a host that shares this file system keeps the one key.
 # Signed: each host gets the roster (public) and the keys of its own actors only, the same way.
+remote_path() {  # a path under the run dir as the host sees it (relative: under MASA_REMOTE_DIR)
+  [[ $1 = /* ]] && echo "$1" || echo "$remote_dir/$1"
+}
 if [ "$auth_mode" = signed ]; then
   carry_file() {  # host, file under run_dir, umask
     local q
     q=$(printf %q "$run_dir/$2")
     "${remote_shell[@]}" "$1" "cd $(printf %q "$remote_dir") && umask $3 && mkdir -p $(printf %q "$run_dir/keys") && cat > $q.tmp.\$\$ && mv -f $q.tmp.\$\$ $q" \
-      < "$run_dir/$2" || { echo "train.sh: cannot carry $2 to $1 (to $remote_dir/$run_dir/$2 there)" >&2; exit 2; }
+      < "$run_dir/$2" || { echo "train.sh: cannot carry $2 to $1 (to $(remote_path "$run_dir/$2") there)" >&2; exit 2; }
   }
   a=0
   for i in "${!hosts[@]}"; do
@@ -295,7 +298,7 @@ if [ "$auth_mode" = hmac ]; then
     key_q=$(printf %q "$run_dir/run.key")
     carry="cd $(printf %q "$remote_dir") && mkdir -p $(printf %q "$run_dir") && umask 077 && cat > $key_q.tmp.\$\$ && mv -f $key_q.tmp.\$\$ $key_q"
     "${remote_shell[@]}" "$h" "$carry" < "$run_dir/run.key" ||
-      { echo "train.sh: cannot carry the run key to $h (to $remote_dir/$run_dir/run.key there)" >&2; exit 2; }
+      { echo "train.sh: cannot carry the run key to $h (to $(remote_path "$run_dir/run.key") there)" >&2; exit 2; }
   done
 fi
 
