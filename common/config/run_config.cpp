@@ -7,6 +7,7 @@
 #include "common/config/config_layers.hpp"
 #include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
+#include "common/core/env_directory.hpp"
 
 namespace masa::config {
 namespace fs = std::filesystem;
@@ -37,8 +38,7 @@ ConfigSection sectionOf(const RunConfig& config, const std::string& prefix) {
 }
 
 std::string defaultConfigsDir() {
-  if (const char* env = std::getenv("MASA_CONFIGS")) return env;
-  return std::string(MASA_SOURCE_DIR) + "/configs";
+  return directoryFromEnvironment("MASA_CONFIGS", std::string(MASA_SOURCE_DIR) + "/configs");
 }
 
 RunConfig loadRunConfig(const std::string& configs_dir, const std::vector<std::string>& overrides,

@@ -4,13 +4,13 @@
 #include <stdexcept>
 
 #include "common/core/config_error.hpp"
+#include "common/core/env_directory.hpp"
 
 namespace masa::task {
 namespace {
 
 std::string sourceRoot() {
-  if (const char* env = std::getenv("MASA_ROOT")) return env;
-  return MASA_SOURCE_DIR;
+  return directoryFromEnvironment("MASA_ROOT", MASA_SOURCE_DIR);
 }
 
 }  // namespace
