@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "common/core/check.hpp"
+#include "common/core/config_error.hpp"
 #include "common/symmetry/group_element.hpp"
 #include "tasks/tasks.hpp"
 
@@ -34,6 +35,13 @@ class TrifingerLift final : public Task {
     cube_init_radius_ = p.number("cube_init_radius", 0.08);
     goal_radius_ = p.number("goal_radius", 0.10);
     goal_max_height_ = p.positive("goal_max_height", 0.10);
+    // A curriculum on the goal's orientation (issue #31: no policy learned to turn the cube toward a
+    // uniformly random orientation, the error stayed at chance): below pi the goal is the cube's
+    // start orientation turned by at most this angle about a random axis, so turning pays before
+    // it needs a full regrasp. pi (the default) is the paper's uniform goal, drawn as before.
+    goal_max_angle_ = p.number("goal_max_angle", M_PI);
+    if (!(goal_max_angle_ > 0.0 && goal_max_angle_ <= M_PI + 1e-9))
+      throw ConfigError(p.origin("goal_max_angle"), "env.goal_max_angle", "must be in (0, pi] rad, got " + std::to_string(goal_max_angle_));
     success_pos_tol_ = p.positive("success_position_tolerance", 0.02);
     success_rot_tol_ = p.positive("success_orientation_tolerance", 0.4);
 
@@ -89,8 +97,18 @@ class TrifingerLift final : public Task {
     // Goal: uniformly random orientation (Shoemake), centre in a disc, height between the lowest
     // height at which that orientation clears the table and goal_max_height.
     const double u1 = unit(rng), u2 = 2.0 * M_PI * unit(rng), u3 = 2.0 * M_PI * unit(rng);
-    goal_quat_ = Eigen::Quaterniond(std::sqrt(u1) * std::cos(u3), std::sqrt(1.0 - u1) * std::sin(u2),
-                                    std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3));
+    if (goal_max_angle_ >= M_PI - 1e-9) {
+      goal_quat_ = Eigen::Quaterniond(std::sqrt(u1) * std::cos(u3), std::sqrt(1.0 - u1) * std::sin(u2),
+                                      std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3));
+    } else {
+      // The start orientation turned (in the world frame) by an angle up to goal_max_angle about an
+      // axis uniform on the sphere: a rotation about z maps this distribution onto itself, so the
+      // C3 symmetry of the task holds.
+      const double cz = 2.0 * u1 - 1.0, sz = std::sqrt(std::max(0.0, 1.0 - cz * cz));
+      const Eigen::Vector3d axis(sz * std::cos(u2), sz * std::sin(u2), cz);
+      const Eigen::Quaterniond turn(Eigen::AngleAxisd(goal_max_angle_ * u3 / (2.0 * M_PI), axis));
+      goal_quat_ = (turn * Eigen::Quaterniond(c[3], c[4], c[5], c[6])).normalized();
+    }
     if (goal_quat_.w() < 0) goal_quat_.coeffs() *= -1.0;
     const Eigen::Matrix3d r = goal_quat_.toRotationMatrix();
     const double z_min = cube_half_ * (std::abs(r(2, 0)) + std::abs(r(2, 1)) + std::abs(r(2, 2)));
@@ -224,6 +242,7 @@ class TrifingerLift final : public Task {
   }
 
   double kp_, kd_, max_velocity_, keypoint_scale_, joint_noise_, cube_init_radius_, goal_radius_, goal_max_height_;
+  double goal_max_angle_ = M_PI;
   double success_pos_tol_, success_rot_tol_;
   int cube_qpos_ = 0;
   double cube_half_ = 0.0;

@@ -164,6 +164,41 @@ TEST(TrifingerLift, PhysicsSymmetryCheckPassesAndObservationIsEquivariant) {
   for (const auto& e : r.joints) EXPECT_LT(e.error, 1e-9) << e.name;
 }
 
+// Issue #31: the goal curriculum. env.goal_max_angle below pi draws the goal as the cube's start
+// orientation turned by at most that angle, so right after a reset the orientation error is at most
+// the angle; pi keeps the uniform goal (errors up to pi, about 2.2 rad on average), drawn exactly as
+// before; the physics symmetry check still passes with the curriculum on.
+TEST(TrifingerLift, TheGoalCurriculumBoundsTheStartingOrientationErrorAndKeepsTheSymmetry) {
+  const TaskFactory near = runConfigFactory(kTask, {"env.goal_max_angle=0.5"});
+  const TaskFactory uniform = runConfigFactory(kTask);
+  auto a = near.create();
+  auto b = uniform.create();
+  double largest_near = 0, mean_uniform = 0;
+  for (int seed = 0; seed < 40; ++seed) {
+    Rng ra(seed), rb(seed);
+    a->reset(ra);
+    b->reset(rb);
+    double e[2];
+    a->progress(e);
+    largest_near = std::max(largest_near, e[1]);
+    b->progress(e);
+    mean_uniform += e[1] / 40;
+  }
+  EXPECT_LE(largest_near, 0.5 + 1e-9);
+  EXPECT_GT(largest_near, 0.3) << "the angles fill the range";
+  EXPECT_GT(mean_uniform, 1.6) << "the default goal stays uniform";
+  const SymmetryReport r = verifySymmetry(near, {.num_states = 10, .max_warmup_steps = 100, .tolerance = kTolerance});
+  EXPECT_TRUE(r.passed()) << r.summary(8);
+  for (const std::string bad : {"0", "-0.1", "3.5"}) {
+    try {
+      runConfigFactory(kTask, {"env.goal_max_angle=" + bad});
+      ADD_FAILURE() << "goal_max_angle " << bad << " was accepted";
+    } catch (const std::exception& ex) {
+      EXPECT_NE(std::string(ex.what()).find("env.goal_max_angle"), std::string::npos) << ex.what();
+    }
+  }
+}
+
 // The upper joint is not mirror-symmetric (its range is [-0.33, 1.0] and the finger hangs off to one
 // side), so claiming that fingers 1 and 2 measure it with the opposite sign must be refuted by the
 // simulation, naming an upper joint.
