@@ -258,6 +258,7 @@ void Actor::awaitNewerParams() {
     transport_->drain();
     maybeHeartbeat();
   }
+  if (std::max(pending_version_, version_) < needed && !stopRequested()) await_budget_.observeTimeout();
 }
 
 bool Actor::collectAndPublish() {

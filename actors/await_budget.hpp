@@ -24,6 +24,15 @@ class AwaitBudget {
   }
   double learnerDelaySeconds() const { return learner_delay_s_; }
 
+  // A wait ended without the parameters it waited for. Before any answer was measured the learner's
+  // first update may simply outlast the configured wait (a big batch: 9 s for 15 actors on one
+  // learner core on the 16-core machine), and each actor then sent a stale rollout every second
+  // until it ended: the next wait is twice as long, up to the bound. Once answers are measured the
+  // answer times (PolicyLagWindow keeps the time since the rollout waited on) set the wait.
+  void observeTimeout() {
+    if (learner_delay_s_ <= 0 && base_s_ > 0) base_s_ = std::min(2.0 * base_s_, max_s_);
+  }
+
   double limitSeconds() const {
     if (base_s_ <= 0) return 0.0;
     if (learner_delay_s_ <= 0) return base_s_;  // not measured yet

@@ -574,6 +574,8 @@ TEST(ActorRollouts, TheLearnersRepeatedParametersKeepTheActorGoing) {
   FakeLearner learner(rc, 5);
   auto opt = options(2, 6);
   opt.await_params_s = 0.15;
+  opt.await_params_max_s = 0.15;  // this fake repeats only when a rollout comes: waits that grow
+                                  // (no answer ever comes) would starve it; a real learner repeats on its own
   opt.learner_silence_pause_s = 0.3;
   opt.learner_silence_exit_s = 0.6;
   // Every rollout is answered with a repeat of version 0, as a busy learner's republish would be.

@@ -28,6 +28,27 @@ TEST(AwaitBudget, AFastLearnersWaitIsShortNotTheConfiguredSecond) {
   EXPECT_DOUBLE_EQ(floor.limitSeconds(), 0.02);
 }
 
+// Before the first answer, a wait that times out doubles the next (the learner's first update may
+// outlast the configured second: each actor sent a stale rollout a second until it ended, 1440
+// dropped chunks at 15 actors on the 16-core machine); after answers are measured they decide.
+TEST(AwaitBudget, BeforeAnyAnswerATimedOutWaitDoublesTheNextUpToTheBound) {
+  AwaitBudget b(1.0, 10.0);
+  b.observeTimeout();
+  EXPECT_DOUBLE_EQ(b.limitSeconds(), 2.0);
+  b.observeTimeout();
+  b.observeTimeout();
+  EXPECT_DOUBLE_EQ(b.limitSeconds(), 8.0);
+  b.observeTimeout();
+  EXPECT_DOUBLE_EQ(b.limitSeconds(), 10.0) << "the bound";
+  b.observeAnswer(0.5);
+  EXPECT_NEAR(b.limitSeconds(), 0.75, 1e-12) << "a measured answer sets the wait";
+  b.observeTimeout();
+  EXPECT_NEAR(b.limitSeconds(), 0.75, 1e-12) << "after answers, a timeout is a loss, not a slow learner";
+  AwaitBudget off(0.0, 10.0);
+  off.observeTimeout();
+  EXPECT_DOUBLE_EQ(off.limitSeconds(), 0.0) << "switched off stays off";
+}
+
 TEST(AwaitBudget, IsBoundedAndCanBeSwitchedOff) {
   AwaitBudget b(1.0, 10.0);
   b.observeAnswer(60.0);  // a learner stuck in a long evaluation
