@@ -5,6 +5,7 @@
 #   bench/e2e_ranks.sh [task] --ranks L --actors A [--envs E] [--threads T] [--updates N] [--warmup W] [--out DIR]
 #                      [--lag G] [--set key=value ...]
 # --lag G: ppo.max_policy_lag (1: actors collect the next rollout while the learner learns).
+# MASA_LCM_URL: the URL (default: loopback multicast on a random port).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 task=a1_beam
@@ -27,7 +28,7 @@ done
 out=${out:-$(mktemp -d /tmp/masa_e2e_ranks.XXXXXX)}
 mkdir -p "$out"
 samples=$((actors * envs * 24))
-MASA_LCM_URL="udpm://239.255.76.67:$((7600 + RANDOM % 50 * 8))?ttl=0&recv_buf_size=8388608" \
+MASA_LCM_URL="${MASA_LCM_URL:-udpm://239.255.76.67:$((7600 + RANDOM % 50 * 8))?ttl=0&recv_buf_size=8388608}" \
   deploy/cluster/mpirun_train.sh "$task" masa --ranks "$ranks" --actors "$actors" --envs "$envs" --threads "$threads" \
   --updates "$updates" --run-dir "$out/run" --set ppo.horizon=24 --set ppo.minibatch_size=$((samples / 4)) \
   --set runner.eval_every=0 --set runner.plot_every=0 --set "ppo.max_policy_lag=$lag" "${sets[@]+"${sets[@]}"}" \

@@ -15,7 +15,8 @@ fail() { echo "FAIL: $*"; for f in grid/a1_beam/*.log grid*.out; do [ -f "$f" ] 
 grid=("$src/experiments/grid.sh" --tasks a1_beam --methods "masa sa" --seeds 0 --updates 150 --jobs 1 --no-recipe
       --out grid --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.num_envs=8
       --set ppo.horizon=8 --set ppo.minibatch_size=64 --set env.max_episode_steps=40
-      --set runner.checkpoint_every=5 --set runner.eval_every=5 --set runner.eval_episodes=1)
+      --set runner.checkpoint_every=5 --set runner.eval_every=5 --set runner.eval_episodes=1
+      --set runner.plot_every=0)  # curves drawn on exit only: 15 renders a run cost seconds here
 
 # 1. Killed during masa's run, after a checkpoint or two.
 "${grid[@]}" > grid1.out 2>&1 &

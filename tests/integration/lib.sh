@@ -9,8 +9,10 @@ actor_bin="$build/actors/masa_actor"
 masa_repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 
 # Small networks and batches: these tests are about the system, not learning. 2 actors x 8 envs.
+# The learning curve is drawn on exit only (a gnuplot render every 10 updates cost the suite seconds).
 test_sets=(--set task=a1_beam --set method=masa --set ppo.num_envs=16 --set ppo.horizon=32
-           --set ppo.minibatch_size=256 --set model.policy_hidden=[16] --set model.critic_hidden=[16])
+           --set ppo.minibatch_size=256 --set model.policy_hidden=[16] --set model.critic_hidden=[16]
+           --set runner.plot_every=0)
 
 started_pids=()
 

@@ -25,7 +25,7 @@ unshare -m python3 tests/integration/hide_system_libraries.py "$work/bundle" bas
   if LD_LIBRARY_PATH= "$MASA_BUILD_DIR/learner/masa_learner" --help > /dev/null 2>&1; then
     echo "FAIL: the learner ran without the bundle: nothing was hidden"; exit 1
   fi
-  bench/e2e_ranks.sh a1_beam --ranks 2 --actors 2 --envs 16 --updates 3 --warmup 1 --out "$2/e2e" \
+  MASA_LCM_URL="udpm://239.255.76.67:7733?ttl=0&recv_buf_size=8388608" bench/e2e_ranks.sh a1_beam --ranks 2 --actors 2 --envs 16 --updates 3 --warmup 1 --out "$2/e2e" \
     --set model.policy_hidden=[16] --set model.critic_hidden=[16]
 ' _ "$work/bundle" "$work" > "$work/run.log" 2>&1 || { tail -n 30 "$work/run.log"; tail -n 30 "$work/e2e/train.log" 2> /dev/null; echo "FAIL: the bundle did not train"; exit 1; }
 grep -q "ranks 2 actors 2 x 16 envs.*fps [0-9]" "$work/run.log" || { cat "$work/run.log"; echo "FAIL: no fps line"; exit 1; }
