@@ -4,7 +4,7 @@
 # programs, every shared library they load that is not the C/C++ runtime, and a relocatable copy of
 # Debian's Open MPI (mpirun, its components, PMIx and their libraries, help texts). On the machine,
 # `source DIR/env.sh` points PATH, LD_LIBRARY_PATH, Open MPI and PMIx at the folder and sets
-# MASA_BUILD_DIR; tests/integration/device_bundle.sh trains with 2 ranks from it with the system's
+# MASA_BUILD_DIR; tests/mpi/device_bundle.sh trains with 2 ranks from it with the system's
 # copies hidden.
 #   bench/device_bundle.sh [--build BUILD] [--out DIR] [--programs "PATH ..."]   (default: build, .device,
 #                          the four programs of scaling_device.sh, paths inside BUILD)

@@ -135,22 +135,31 @@ TEST(A1BeamReward, StandingStillEarnsOnlyThePartialSpeedTrackingReward) {
   EXPECT_EQ(rewardTerm(*t, "action"), 0.0);
 }
 
+// One step of a task with velocity_reward `form` (velocity weight 2) from a level trunk moving
+// forward at vx: the velocity term it paid and the forward speed after the step it was paid on.
+struct VelocityStep {
+  double term, v;
+};
+VelocityStep velocityStepAt(const std::string& form, double vx) {
+  const double quat[4] = {1, 0, 0, 0};
+  const TaskFactory f = runConfigFactory(kTask, {"env.velocity_reward=" + form, "env.weights.velocity=2.0"});
+  auto t = f.create();
+  Rng rng(3);
+  t->reset(rng);
+  const double lin[3] = {vx, 0.0, 0.0};
+  setTrunk(*t, 0.0, 0.0, t->data()->qpos[2], quat, lin);
+  std::vector<float> zero(t->actDim(), 0.0f);
+  EXPECT_FALSE(t->step(zero.data()).terminated) << form << " at v_x " << vx;
+  return {rewardTerm(*t, "velocity"), t->data()->qvel[0]};
+}
+
 // Issue #34: under the paper's exp(-|v - target|) standing still earns 0.61 of the speed term,
 // and the off-policy learner settles there. env.velocity_reward: progress pays v_x / target,
 // clamped to [-1, 1]: nothing for standing, the full term at the target, no more beyond it.
 TEST(A1BeamReward, TheProgressFormPaysNothingForStandingAndTheFullTermAtTheTarget) {
-  const double quat[4] = {1, 0, 0, 0};
   for (const double vx : {0.0, 0.25, 0.5, 0.9, -0.8}) {
-    const TaskFactory f = runConfigFactory(kTask, {"env.velocity_reward=progress", "env.weights.velocity=2.0"});
-    auto t = f.create();
-    Rng rng(3);
-    t->reset(rng);
-    const double lin[3] = {vx, 0.0, 0.0};
-    setTrunk(*t, 0.0, 0.0, t->data()->qpos[2], quat, lin);
-    std::vector<float> zero(t->actDim(), 0.0f);
-    ASSERT_FALSE(t->step(zero.data()).terminated);
-    const double v = t->data()->qvel[0];  // after the step
-    EXPECT_DOUBLE_EQ(rewardTerm(*t, "velocity"), 2.0 * std::clamp(v / 0.5, -1.0, 1.0)) << "v_x " << vx;
+    const VelocityStep s = velocityStepAt("progress", vx);
+    EXPECT_DOUBLE_EQ(s.term, 2.0 * std::clamp(s.v / 0.5, -1.0, 1.0)) << "v_x " << vx;
   }
   try {
     runConfigFactory(kTask, {"env.velocity_reward=linear"});
@@ -165,22 +174,13 @@ TEST(A1BeamReward, TheProgressFormPaysNothingForStandingAndTheFullTermAtTheTarge
 // most at the target and less on either side: half at half and at one and a half times the target,
 // nothing for standing and at twice the target.
 TEST(A1BeamReward, TheTentFormPaysMostAtTheTargetAndLessOnEitherSide) {
-  const double quat[4] = {1, 0, 0, 0};
   double at_target = 0, above = 0;
   for (const double vx : {0.0, 0.25, 0.5, 0.75, 1.0, 1.3, -0.8}) {
-    const TaskFactory f = runConfigFactory(kTask, {"env.velocity_reward=tent", "env.weights.velocity=2.0"});
-    auto t = f.create();
-    Rng rng(3);
-    t->reset(rng);
-    const double lin[3] = {vx, 0.0, 0.0};
-    setTrunk(*t, 0.0, 0.0, t->data()->qpos[2], quat, lin);
-    std::vector<float> zero(t->actDim(), 0.0f);
-    ASSERT_FALSE(t->step(zero.data()).terminated);
-    const double v = t->data()->qvel[0];  // after the step
-    const double expected = v <= 0.5 ? std::max(v / 0.5, -1.0) : std::max(2.0 - v / 0.5, 0.0);
-    EXPECT_DOUBLE_EQ(rewardTerm(*t, "velocity"), 2.0 * expected) << "v_x " << vx;
-    if (vx == 0.5) at_target = rewardTerm(*t, "velocity");
-    if (vx == 0.75) above = rewardTerm(*t, "velocity");
+    const VelocityStep s = velocityStepAt("tent", vx);
+    const double expected = s.v <= 0.5 ? std::max(s.v / 0.5, -1.0) : std::max(2.0 - s.v / 0.5, 0.0);
+    EXPECT_DOUBLE_EQ(s.term, 2.0 * expected) << "v_x " << vx;
+    if (vx == 0.5) at_target = s.term;
+    if (vx == 0.75) above = s.term;
   }
   EXPECT_GT(at_target, 1.9) << "the full term near the target";
   EXPECT_NEAR(above, 1.0, 0.1) << "half of it at 1.5 times the target (the progress form pays all of it)";
