@@ -26,7 +26,7 @@ exec > >(tee -a "$log") 2>&1
 start=$SECONDS
 pack() {  # the archive of everything but checkpoints and environments, and the tables beside it
   tar -C "$work" --exclude='*.bin' --exclude='*.key' -czf "$out/scaling_device.tar.gz" . 2> /dev/null
-  for f in learner_ranks.txt actors.txt ranks.txt model.txt points.txt check/check.txt; do
+  for f in learner_ranks.txt actors.txt ranks.txt probe.txt model.txt points.txt check/check.txt; do
     [ -f "$work/$f" ] && cp "$work/$f" "$out/$(basename "$f")"
   done
   echo "device_session.sh: $((SECONDS - start)) s; back: $(ls "$out" | tr '\n' ' ')"

@@ -8,15 +8,17 @@
 #     ppo.max_policy_lag 0 (they take turns) and 1 (they overlap), and C actors sharing the cores
 #     with the ranks;
 #  3. the model's prediction beside each measured point (OUT/check.txt).
-#   bench/scaling_check.sh [--cores C] [--envs E] [--updates N] [--out DIR]   (MASA_BUILD_DIR: the build)
+#   bench/scaling_check.sh [--cores C] [--envs E] [--updates N] [--costs-only] [--out DIR]   (MASA_BUILD_DIR: the build)
+# --costs-only: step 1 alone (scaling_device.sh's tables put the model beside their own points).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cores=$(nproc) envs=64 updates=16 warmup=5 out=/tmp/masa_scaling_check
+cores=$(nproc) envs=64 updates=16 warmup=5 costs_only=0 out=/tmp/masa_scaling_check
 while [ $# -gt 0 ]; do
   case "$1" in
     --cores) cores=$2; shift 2 ;;
     --envs) envs=$2; shift 2 ;;
     --updates) updates=$2; shift 2 ;;
+    --costs-only) costs_only=1; shift ;;
     --out) out=$2; shift 2 ;;
     *) echo "scaling_check.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -46,6 +48,7 @@ cat > "$out/costs.json" << EOF
  "minibatches_x_epochs": 20, "param_bytes": $params, "bytes_per_sample": $wire, "grad_bytes": $((grad_floats * 4)),
  "nic_gbps": 10, "nic_latency_us": 30}
 EOF
+(( costs_only )) && { echo "scaling_check.sh: $out/costs.json (--costs-only: no points)" >&2; exit 0; }
 
 # 2. Measured points: "fps MEASURED A E H L T CORES LAG" (scaling_model.py check's lines).
 : > "$out/points.txt"
