@@ -20,6 +20,7 @@
 #include "learner/checkpoint.hpp"
 #include "learner/intake/drop_reason.hpp"
 #include "learner/metrics_csv.hpp"
+#include "learner/run_directory.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "masa/lcmt_policy_params.hpp"
@@ -82,6 +83,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
                                                                      << ranks_->size() << " learner ranks");
   MASA_CHECK(opt_.rank_check_every > 0, "rank_check_every must be positive, got " << opt_.rank_check_every);
   min_batch_envs_ = static_cast<int>(std::ceil(rc.runner.min_batch_fraction * rank_envs_));
+  if (isLeadRank() && !opt_.resume) refuseRunDirInUse(dir_);
   if (isLeadRank()) fs::create_directories(dir_);
   const auto spec = sym::SymmetrySpec::load(rc_.spec_path);
   model_ = std::make_unique<model::ActorCritic<float>>(spec, modelConfigOf(rc_));

@@ -11,6 +11,7 @@
 #include "common/core/binary_io.hpp"
 #include "common/model/method.hpp"
 #include "common/sim/registry.hpp"
+#include "learner/run_directory.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_policy_file.hpp"
 #include "learner/sac/trainer_factory.hpp"
@@ -68,6 +69,7 @@ struct SacRun::Impl {
     env = factory->create();
     progress_names = env->progressNames();
     obs.resize(spec.obsDim());
+    if (!opt.resume) learner::refuseRunDirInUse(opt.run_dir);
     fs::create_directories(opt.run_dir);
     std::ofstream(fs::path(opt.run_dir) / "config.yaml") << config::dumpResolved(rc);
     if (opt.resume) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <thread>
 #include <random>
 #include <sstream>
@@ -294,6 +295,46 @@ TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv)
   EXPECT_EQ(lines[2].rfind("2,64,", 0), 0u);
   fs::remove_all(dir_a);
   fs::remove_all(dir_b);
+}
+
+// A second fresh run given the first one's directory: refused before anything is written, so the
+// first run's checkpoint stays what a resume needs and its metrics.csv keeps one run's rows (the
+// device probes of issue #30 repeated a point into one directory: three runs' rows in one file).
+TEST(LearnerNode, AFreshRunInADirectoryThatHoldsARunIsRefusedAndTheRunIsUntouched) {
+  auto rc = smallConfig();
+  rc.runner.checkpoint_every = 1;
+  const fs::path dir = freshDir("in_use");
+  FakeActor actor(rc, 10);
+  {
+    Learner a(rc, options(dir, 9));
+    actor.send(a.transport(), 9, 0, 0);
+    ASSERT_TRUE(stepUntilUpdate(a));
+  }
+  const auto read = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  const std::string checkpoint = read(dir / "checkpoint.bin"), metrics = read(dir / "metrics.csv");
+  ASSERT_FALSE(checkpoint.empty());
+  try {
+    Learner b(rc, options(dir, 10));
+    FAIL() << "a fresh run was started in a directory holding a run";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(dir.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("checkpoint.bin"), std::string::npos) << what;
+    EXPECT_NE(what.find("--resume"), std::string::npos) << what;
+  }
+  EXPECT_EQ(read(dir / "checkpoint.bin"), checkpoint);
+  EXPECT_EQ(read(dir / "metrics.csv"), metrics);
+  // Only the metrics of a run that never checkpointed: refused as well. An empty one, or a
+  // directory of the launchers' files only, is a fresh start.
+  fs::remove(dir / "checkpoint.bin");
+  EXPECT_THROW(Learner(rc, options(dir, 10)), std::runtime_error);
+  std::ofstream(dir / "metrics.csv", std::ios::trunc).flush();
+  std::ofstream(dir / "job_roster") << "launcher's file\n";
+  EXPECT_NO_THROW(Learner(rc, options(dir, 10)));
+  fs::remove_all(dir);
 }
 
 // kill -9 of the learner between two checkpoints: metrics.csv has rows for updates the checkpoint
