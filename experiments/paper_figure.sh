@@ -16,6 +16,11 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -n "$out" ] && [ ${#panels[@]} -gt 0 ] || { echo "usage: paper_figure.sh --out FILE.png TITLE=CURVES_DIR ..." >&2; exit 2; }
+for p in "${panels[@]}"; do  # a mistyped directory is an error, not a task "not measured yet"
+  dir=${p#*=}
+  [ "$dir" = "-" ] || [ -f "$dir/return_masa.dat" ] ||
+    { echo "paper_figure.sh: '$dir' has no return_masa.dat (a grid's TASK/curves folder, or - for a task not measured)" >&2; exit 2; }
+done
 command -v gnuplot > /dev/null || { echo "paper_figure.sh: gnuplot is not installed (scripts/install_deps.sh)" >&2; exit 2; }
 methods=(masa sa sasa ma) colours=('#d62728' '#1f77b4' '#2ca02c' '#9467bd')
 gp=${out%.png}.gp
@@ -35,7 +40,7 @@ n=${#panels[@]}
   for p in "${panels[@]}"; do
     title=${p%%=*} dir=${p#*=}
     echo "set title '$title'"
-    if [ "$dir" = "-" ] || [ ! -f "$dir/return_masa.dat" ]; then
+    if [ "$dir" = "-" ]; then
       echo "unset key; set xrange [0:1]; set yrange [0:1]; unset xtics; unset ytics"
       echo "set label 1 'not measured yet' at 0.5,0.5 center font ',13'"
       echo "plot NaN notitle"
