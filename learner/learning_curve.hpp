@@ -57,7 +57,8 @@ std::string gnuplotQuoted(const std::string& s);
 
 // gnuplot script text for a metrics.csv with these reward terms (exposed for tests).
 // ppo_panels false (learner: off_policy): the KL and learning-rate panel, both 0 there (on a log
-// scale gnuplot finds no point and stops drawing), becomes one of the entropy and the critic loss.
+// scale gnuplot finds no point and stops drawing), becomes one of the mean Q and the entropy from the
+// run's off_policy.csv, and the throughput is on a log scale (the warm-up rounds are far faster).
 std::string learningCurveScript(const std::string& title, const std::vector<std::string>& term_names,
                                 bool has_success = true, bool ppo_panels = true);
 

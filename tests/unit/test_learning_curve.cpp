@@ -83,10 +83,21 @@ TEST(LearningCurve, AnOffPolicyRunWithZeroKlAndLearningRateIsDrawnWithItsOwnPane
         << ",nan,0,0,0,0,0,0,0,0,0,nan,nan,nan\n";
   }
   {
+    std::ofstream f(dir / "off_policy.csv");  // the learner's, before every render; TD3: entropy nan
+    f << "update,env_steps,policy_lag_mean,policy_lag_max,gradient_steps,gradient_steps_total,replay_size,"
+         "warming_up,q_loss,actor_loss,alpha_loss,symmetry_loss,alpha,mean_q,entropy\n";
+    for (int i = 0; i < 5; ++i)
+      f << i + 1 << ',' << (i + 1) * 512 << ",0,0,128,128,512,0,1,-1,0,0,0," << 10 + i << ",nan\n";
+  }
+  const std::string script = learningCurveScript("a1_beam / masa", {"alive"}, false, false);
+  EXPECT_NE(script.find("\"off_policy.csv\" using (column(\"env_steps\")/1e6):\"mean_q\""), std::string::npos)
+      << "the off-policy panel draws the mean Q";
+  EXPECT_EQ(script.find("title \"twin-Q loss\""), std::string::npos) << "the critic loss is drawn once, in the losses";
+  {
     LearningCurve ppo(dir.string(), "a1_beam / masa", {"alive"}, false);
     EXPECT_FALSE(ppo.renderAndWait()) << "PPO's KL panel cannot be drawn from zeros: the case this guards";
   }
-  LearningCurve off(dir.string(), LearningCurve::Script{learningCurveScript("a1_beam / masa", {"alive"}, false, false)});
+  LearningCurve off(dir.string(), LearningCurve::Script{script});
   ASSERT_TRUE(off.renderAndWait()) << "gnuplot log: " << (dir / "learning_curve.log");
   EXPECT_TRUE(isPng(off.pngPath()));
   fs::remove_all(dir);
