@@ -150,7 +150,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
     }
   }
 
-  start_ = last_update_ = std::chrono::steady_clock::now();
+  start_ = last_update_ = idle_since_ = std::chrono::steady_clock::now();
   silence_ = std::make_unique<SilenceWatch>(rc_.runner.silence_warn_s, start_);
   if (isLeadRank()) publishParams();
 }
@@ -335,6 +335,12 @@ void Learner::update() {
     std::chrono::steady_clock::time_point from = std::chrono::steady_clock::now();
     ~ExcuseBusyTime() { watch.learnerWasBusy(std::chrono::steady_clock::now() - from); }
   } excuse{*silence_};
+  const auto began = std::chrono::steady_clock::now();
+  report_.wait_s = std::chrono::duration<double>(began - idle_since_).count();
+  struct MarkIdle {  // however update() returns (rank 0 publishes and reports; the others return early)
+    std::chrono::steady_clock::time_point& since;
+    ~MarkIdle() { since = std::chrono::steady_clock::now(); }
+  } mark_idle{idle_since_};
   // How far behind the parameters being trained the batch's environments acted, in updates.
   double lag_mean = 0;
   int64_t lag_max = 0;
@@ -350,6 +356,7 @@ void Learner::update() {
   }
 
   const auto now = std::chrono::steady_clock::now();
+  report_.learn_s = std::chrono::duration<double>(now - began).count();
   const double dt = std::chrono::duration<double>(now - last_update_).count();
   last_update_ = now;
   int64_t steps = static_cast<int64_t>(buffer_->size());

@@ -186,6 +186,7 @@ class Learner {
   int64_t updates_ = 0, env_steps_ = 0;
   double wall_offset_s_ = 0;  // wall time of the runs before a resume
   std::chrono::steady_clock::time_point start_, last_update_, last_publish_;
+  std::chrono::steady_clock::time_point idle_since_;  // the end of the last update (or the start): what wait_s counts from
   std::vector<int> restored_order_;  // shuffle permutation from a checkpoint, used once
   std::unique_ptr<LearningCurve> curve_;  // made with the first update: it needs the reward terms
   int64_t max_updates_ = -1;              // of the current run(), for the ETA; -1: unknown

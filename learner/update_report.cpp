@@ -140,11 +140,14 @@ void printProgress(const UpdateReport& report, const ReportColumns& columns, int
   if (report.algorithm_figures.empty())
     std::snprintf(ppo, sizeof(ppo), "kl %.5f  lr %.2e  actor %.4f  critic %.4f", report.ppo.kl, report.ppo.lr,
                   report.ppo.actor_loss, report.ppo.critic_loss);
-  std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f%s  %s  dropped %lld chunks %lld envs%s\n",
+  char timing[64] = "";
+  if (!std::isnan(report.learn_s) && !std::isnan(report.wait_s))
+    std::snprintf(timing, sizeof(timing), "  learn %.2fs waited %.2fs", report.learn_s, report.wait_s);
+  std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f%s  %s  dropped %lld chunks %lld envs%s%s\n",
               static_cast<long long>(done), total, static_cast<long long>(report.env_steps), report.fps,
               report.mean_return, report.mean_length, success,
               report.algorithm_figures.empty() ? ppo : report.algorithm_figures.c_str(),
-              static_cast<long long>(report.dropped_chunks), static_cast<long long>(report.dropped_envs), eta);
+              static_cast<long long>(report.dropped_chunks), static_cast<long long>(report.dropped_envs), timing, eta);
   if (!std::isnan(report.eval_return)) {
     std::printf("  eval (policy mean, %d episodes): return %.3f  len %.1f", eval_episodes, report.eval_return,
                 report.eval_length);

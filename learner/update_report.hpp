@@ -31,6 +31,11 @@ struct UpdateReport {
   ppo::PpoStats ppo;
   int64_t dropped_chunks = 0;  // by the assembler, every reason (lost included), since the run began
   int64_t dropped_envs = 0;    // by the collector (stale, overflow), since the run began
+  // Where the update's interval went (rank 0's clock): learn_s computing it (PPO's epochs or the
+  // off-policy round's gradient steps, collectives included), wait_s waiting for its batch since
+  // the previous update ended (evaluation, checkpoint and publishing excluded). A learner that
+  // mostly waits wants more actors; one that mostly learns, more ranks (docs/scaling.md).
+  double learn_s = std::nan(""), wait_s = std::nan("");
   // The policy mean's evaluation (runner.eval_every): NaN in updates without one.
   double eval_return = std::nan(""), eval_length = std::nan(""), eval_success = std::nan("");
   std::vector<double> eval_progress;  // the task's progress figures (Task::progressNames)

@@ -2,6 +2,7 @@
 // valid rollouts of the TriFinger spec's dimensions, chunked as a real actor chunks them.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -295,6 +296,28 @@ TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv)
   EXPECT_EQ(lines[2].rfind("2,64,", 0), 0u);
   fs::remove_all(dir_a);
   fs::remove_all(dir_b);
+}
+
+// The progress line's "learn Xs waited Ys": an update's own time, and the time its batch kept it
+// waiting since the previous update ended (what tells a starved learner from a busy one).
+TEST(LearnerNode, TheReportSaysHowLongTheUpdateLearnedAndHowLongItWaitedForItsBatch) {
+  auto rc = smallConfig();
+  const fs::path dir = freshDir("timing");
+  FakeActor actor(rc, 10);
+  Learner a(rc, options(dir, 9));
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));  // the actors are late
+  actor.send(a.transport(), 9, 0, 0);
+  ASSERT_TRUE(stepUntilUpdate(a));
+  const UpdateReport first = a.lastReport();
+  EXPECT_GE(first.wait_s, 0.15);
+  EXPECT_GT(first.learn_s, 0.0);
+  EXPECT_LT(first.learn_s, first.wait_s) << "a tiny update outlasted the 150 ms wait";
+  actor.send(a.transport(), 9, 1, 1);  // the next batch is there as soon as the update ends
+  ASSERT_TRUE(stepUntilUpdate(a));
+  const UpdateReport second = a.lastReport();
+  EXPECT_LT(second.wait_s, 0.15);
+  EXPECT_GT(second.learn_s, 0.0);
+  fs::remove_all(dir);
 }
 
 // A second fresh run given the first one's directory: refused before anything is written, so the
