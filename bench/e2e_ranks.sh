@@ -43,5 +43,12 @@ mean=$(awk -F, -v w="$warmup" 'NR == 1 { for (i = 1; i <= NF; i++) { if ($i == "
   $1 == w { s0 = $s; t0 = $t } { s1 = $s; t1 = $t } END { print (t1 > t0) ? (s1 - s0) / (t1 - t0) : "nan" }' "$out/run/metrics.csv")
 dropped=$(tail -n 1 "$out/run/metrics.csv" | awk -F, -v h="$(head -n 1 "$out/run/metrics.csv")" \
   'BEGIN { n = split(h, c, ","); for (i = 1; i <= n; i++) if (c[i] == "dropped_chunks") k = i } { print k ? $k : "?" }')
-printf 'e2e_ranks: %s ranks %d actors %d x %d envs, threads %d, lag %d: fps %.0f (wall clock, updates %d-%d; median of updates %.0f), chunks dropped %s\n' \
-  "$task" "$ranks" "$actors" "$envs" "$threads" "$lag" "$mean" "$warmup" "$updates" "$fps" "$dropped"
+# Rank 0's progress lines: how long each measured update learned and waited for its batch (a
+# learner that mostly waits is short of actors; two modes of a lag-1 pipeline show as two sizes).
+timing=$(sed -n 's|^update \([0-9]*\)/.* learn \([0-9.]*\)s waited \([0-9.]*\)s.*|\1 \2 \3|p' "$out/train.log" |
+  awk -v w="$warmup" '$1 > w { n++; l[n] = $2; q[n] = $3 }
+    function med(a, n,   i, j, t) { for (i = 2; i <= n; i++) for (j = i; j > 1 && a[j - 1] > a[j]; j--) { t = a[j]; a[j] = a[j - 1]; a[j - 1] = t }
+                                     return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
+    END { if (n) printf "; learner: learn %.3fs, waited %.3fs an update (medians)", med(l, n), med(q, n) }')
+printf 'e2e_ranks: %s ranks %d actors %d x %d envs, threads %d, lag %d: fps %.0f (wall clock, updates %d-%d; median of updates %.0f), chunks dropped %s%s\n' \
+  "$task" "$ranks" "$actors" "$envs" "$threads" "$lag" "$mean" "$warmup" "$updates" "$fps" "$dropped" "$timing"

@@ -142,7 +142,7 @@ void printProgress(const UpdateReport& report, const ReportColumns& columns, int
                   report.ppo.actor_loss, report.ppo.critic_loss);
   char timing[64] = "";
   if (!std::isnan(report.learn_s) && !std::isnan(report.wait_s))
-    std::snprintf(timing, sizeof(timing), "  learn %.2fs waited %.2fs", report.learn_s, report.wait_s);
+    std::snprintf(timing, sizeof(timing), "  learn %.3fs waited %.3fs", report.learn_s, report.wait_s);
   std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f%s  %s  dropped %lld chunks %lld envs%s%s\n",
               static_cast<long long>(done), total, static_cast<long long>(report.env_steps), report.fps,
               report.mean_return, report.mean_length, success,
