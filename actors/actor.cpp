@@ -242,12 +242,20 @@ void Actor::maybeHeartbeat() {
   if (acknowledge_ || nowSeconds() - last_heartbeat_s_ >= options_.heartbeat_interval_s) publishHeartbeat();
 }
 
+namespace {
+void keepRecent(std::vector<double>& times, double seconds) {
+  if (times.size() >= Actor::kTimesKept) times.erase(times.begin(), times.begin() + Actor::kTimesKept / 2);
+  times.push_back(seconds);
+}
+}  // namespace
+
 double Actor::awaitLimitSeconds() const {
   return await_budget_.limitSeconds();
 }
 
 void Actor::awaitNewerParams() {
-  const double deadline = nowSeconds() + awaitLimitSeconds();
+  const double began = nowSeconds();
+  const double deadline = began + awaitLimitSeconds();
   // With ppo.max_policy_lag 0 the parameters that answer the rollout just sent; with lag L those
   // that answer the rollout L before it (PolicyLagWindow), so rollouts and updates overlap.
   const int64_t needed = lag_window_.neededVersion();
@@ -259,9 +267,11 @@ void Actor::awaitNewerParams() {
     maybeHeartbeat();
   }
   if (std::max(pending_version_, version_) < needed && !stopRequested()) await_budget_.observeTimeout();
+  keepRecent(await_s_, nowSeconds() - began);
 }
 
 bool Actor::collectAndPublish() {
+  const double began = nowSeconds();
   swapInPending();  // the only place parameters change
   if (!hasParams()) throw std::logic_error("actor: collectAndPublish before any parameters");
   const int64_t acting_version = version_;
@@ -349,6 +359,7 @@ bool Actor::collectAndPublish() {
   }
   ++rollouts_sent_;
   lag_window_.sent(acting_version, nowSeconds());
+  keepRecent(collect_s_, nowSeconds() - began);
   return true;
 }
 

@@ -124,6 +124,12 @@ class Actor {
   int64_t chunksPublished() const { return chunks_published_; }
   int64_t chunksDropped() const { return chunks_dropped_; }  // by drop_chunks_percent
   int64_t paramsRejected() const { return params_rejected_; }
+  // Seconds each recent rollout took to collect and publish, and each wait after it for the
+  // parameters the next one needed (the last kTimesKept of each): beside the learner's "learn /
+  // waited" they say which side of a pipeline waits for which (docs/scaling.md).
+  static constexpr std::size_t kTimesKept = 1024;
+  const std::vector<double>& collectSeconds() const { return collect_s_; }
+  const std::vector<double>& awaitSeconds() const { return await_s_; }
   const transport::MessageBus& transport() const { return *transport_; }
   const rollout::Rollout& lastRollout() const { return rollout_; }
   int numEnvs() const { return num_envs_; }
@@ -193,6 +199,7 @@ class Actor {
   AwaitBudget await_budget_{options_.await_params_s, options_.await_params_max_s, options_.await_params_min_s};
   // Nothing of a rejected message is kept but these counts: it cannot change what comes after it.
   int64_t params_rejected_ = 0;
+  std::vector<double> collect_s_, await_s_;
   int64_t rejects_since_warning_ = 0;
   int behind_in_a_row_ = 0;  // valid parameters below our version since the last at it
   // Parameters at or above our newest version came: the next heartbeat goes out at once, and

@@ -19,6 +19,7 @@
 
 #include "actors/actor.hpp"
 #include "common/core/build_info.hpp"
+#include "common/core/summary_stats.hpp"
 #include "common/config/run_config.hpp"
 #include "common/cluster/job_plan.hpp"
 #include "common/cluster/mpi_job.hpp"
@@ -206,6 +207,11 @@ int main(int argc, char** argv) {
     if (opt.drop_chunks_percent > 0)
       std::fprintf(stderr, ", %lld thrown away by fault injection", static_cast<long long>(actor.chunksDropped()));
     std::fprintf(stderr, "\n");
+    if (!actor.collectSeconds().empty())
+      std::fprintf(stderr, "masa_actor %d: a rollout took %.3f s to collect and %.3f s waiting for parameters after it "
+                   "(medians of the last %zu)\n", opt.actor_id, masa::stats::median(actor.collectSeconds()),
+                   actor.awaitSeconds().empty() ? 0.0 : masa::stats::median(actor.awaitSeconds()),
+                   actor.collectSeconds().size());
     std::fprintf(stderr, "masa_actor %d: parameter messages refused after decoding %lld; rejected before decoding: %s\n",
                  opt.actor_id, static_cast<long long>(actor.paramsRejected()), actor.transport().rejectSummary().c_str());
   } catch (const std::exception& e) {

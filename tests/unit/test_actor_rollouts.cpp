@@ -160,6 +160,26 @@ TEST(ActorRollouts, ChunksFromLearnerParamsPassTheAssemblerWithAllEnvsAndEpisode
   EXPECT_EQ(finals, 3 * E) << "time-limit ends carry their pre-reset observation";
 }
 
+// The actor keeps how long each rollout took and how long it then waited for the parameters the
+// next one needed: here no learner answers, so each wait runs to its budget (0.05 s, then doubled
+// before any answer), and the last rollout is followed by none.
+TEST(ActorRollouts, EachRolloutsCollectTimeAndTheWaitForParametersAfterItAreKept) {
+  const auto rc = smallConfig(1);
+  transport::Transport bus("memq://");
+  FakeLearner learner(rc, 5);
+  actor::ActorOptions opt = options(4, 3);
+  opt.await_params_s = 0.05;
+  actor::Actor actor(rc, opt, &bus);
+  ASSERT_TRUE(bus.publish(transport::kPolicyChannel, learner.message(1)));
+  EXPECT_EQ(actor.run(), 3);
+  ASSERT_EQ(actor.collectSeconds().size(), 3u);
+  for (double s : actor.collectSeconds()) EXPECT_GT(s, 0.0);
+  ASSERT_EQ(actor.awaitSeconds().size(), 2u) << "a wait after each rollout but the last";
+  EXPECT_GE(actor.awaitSeconds()[0], 0.045);
+  EXPECT_GE(actor.awaitSeconds()[1], 0.09) << "a timed-out wait doubles the next before any answer";
+  EXPECT_LT(actor.awaitSeconds()[1], 1.0);
+}
+
 TEST(ActorRollouts, ParametersPublishedMidRolloutApplyFromTheNextRollout) {
   const auto rc = smallConfig(2);
   transport::Transport bus("memq://");
