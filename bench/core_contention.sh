@@ -21,7 +21,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 median() { sort -g | awk '{ v[NR] = $1 } END { print NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 echo "# $(date -u +%FT%TZ) $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'); a1_beam, 128 envs x 24"
-printf '%-6s %12s %12s %10s %10s\n' busy t_env_us t_learn_us env_x learn_x
+printf '%-6s %12s %12s %10s %10s %14s\n' busy t_env_us t_learn_us env_x learn_x slowest_env_us
 base_env="" base_learn=""
 for k in $counts; do
   (( k <= $(nproc) )) || continue
@@ -32,7 +32,9 @@ for k in $counts; do
   wait
   env_us=$(cat "$tmp/$k".* | sed -n 's/^t_env *\([0-9.]*\) .*/\1/p' | median)
   learn_us=$(cat "$tmp/$k".* | sed -n 's/^t_learn *\([0-9.]*\) .*/\1/p' | median)
+  # The slowest core's: a lockstep pipeline (every update waits for every actor) goes at its pace.
+  slowest=$(cat "$tmp/$k".* | sed -n 's/^t_env *\([0-9.]*\) .*/\1/p' | sort -g | tail -n 1)
   base_env=${base_env:-$env_us} base_learn=${base_learn:-$learn_us}
-  awk -v k="$k" -v e="$env_us" -v l="$learn_us" -v e0="$base_env" -v l0="$base_learn" \
-    'BEGIN { printf "%-6s %12.2f %12.2f %10.2f %10.2f\n", k, e, l, e / e0, l / l0 }'
+  awk -v k="$k" -v e="$env_us" -v l="$learn_us" -v e0="$base_env" -v l0="$base_learn" -v m="$slowest" \
+    'BEGIN { printf "%-6s %12.2f %12.2f %10.2f %10.2f %14.2f\n", k, e, l, e / e0, l / l0, m }'
 done
