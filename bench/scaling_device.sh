@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The many-core scaling tables of issue #30 in one short script, for a machine with C cores
 # (written for a 16-core machine; about 10 minutes there). Results under OUT, in this order:
-#  1. check/costs.json: the per-sample costs measured here (bench/scaling_check.sh --costs-only)
+#  1. check/costs.json: the per-sample costs measured here (bench/scaling_check.sh --costs-only), and
+#     contention.txt: the cores' speed with the others busy (bench/core_contention.sh)
 #  2. actors.txt: training fps on the first a cores, a = 1, 2, 4, 8, 12, 14 (a < C), with actors and
 #     learner ranks split by the documented rule: the split of those a cores that the cost model
 #     finds fastest on the costs of step 1 (bench/scaling_model.py plan, ppo.max_policy_lag 1: the
@@ -40,6 +41,9 @@ if [ -z "$costs" ]; then
   costs=$out/check/costs.json
 fi
 [ -f "$costs" ] || { echo "scaling_device.sh: no costs file '$costs'" >&2; exit 2; }
+# Each core's speed with the others busy, and the slowest core's (a lockstep pipeline follows it;
+# bench/results/2026-12-04_two_modes_local/): half a minute, printed into the session's log.
+bench/core_contention.sh --counts "$(printf '%s\n' 1 $((cores / 2)) "$cores" | sort -un | tr '\n' ' ')" --rounds 2 | tee "$out/contention.txt" || true
 
 : > "$out/points.txt"
 run_on() {  # run_on CORES ACTORS RANKS LAG NAME [ENVS]: e2e_ranks.sh on the first CORES cores
