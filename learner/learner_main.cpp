@@ -14,7 +14,6 @@
 #include <atomic>
 #include <memory>
 #include <csignal>
-#include <ctime>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -33,6 +32,7 @@
 #include "common/transport/run_key.hpp"
 #include "learner/intake/drop_reason.hpp"
 #include "learner/learner.hpp"
+#include "learner/run_directory.hpp"
 #include "learner/sac/off_policy_rule.hpp"
 
 namespace {
@@ -41,15 +41,6 @@ std::atomic<bool> g_stop{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
 
 void onSignal(int) { g_stop.store(true); }
-
-std::string timestamp() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  localtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof(buf), "%Y%m%d-%H%M%S", &tm);
-  return buf;
-}
 
 // RUN_DIR/job_roster, whole or not at all (written under a temporary name, then renamed).
 void writeJobRoster(const std::string& run_dir, const masa::transport::Roster& roster) {
@@ -143,7 +134,7 @@ int main(int argc, char** argv) {
   int64_t max_updates = -1;
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set ppo.horizon=8");
   app.add_option("--configs", configs, "configs directory (defaults.yaml, tasks/, specs/)");
-  app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_<timestamp>)");
+  app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_<time>)");
   app.add_option("--resume", resume_dir, "continue the run in this directory from its checkpoint.bin, with its config.yaml (--set still applies)");
   // The same default as masa_actor: loopback multicast with a receive buffer large enough for chunks.
   url = masa::transport::loopbackUrl();
@@ -192,8 +183,8 @@ int main(int argc, char** argv) {
       opt.run_dir = resume_dir;
     } else {
       opt.run_dir = !run_dir.empty() ? run_dir
-                                     : "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" +
-                                           std::to_string(rc.seed) + "_" + timestamp();
+                                     : masa::learner::defaultRunDir(rc.task + "_" + masa::model::methodName(rc.method),
+                                                                    rc.seed);
     }
     if (max_updates < 0) max_updates = rc.ppo.max_updates;
     // Collective over the whole job, whatever the authentication: the actors cannot know it before

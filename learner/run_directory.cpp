@@ -1,5 +1,6 @@
 #include "learner/run_directory.hpp"
 
+#include <ctime>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
@@ -21,6 +22,15 @@ void refuseRunDirInUse(const std::string& dir) {
                              dir + "), or give the new run another directory (starting here would overwrite that " +
                              "run's state and mix two runs in its metrics.csv)");
   }
+}
+
+std::string defaultRunDir(const std::string& name, uint64_t seed) {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  localtime_r(&now, &tm);
+  char stamp[32];
+  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", &tm);
+  return "runs/" + name + "_" + std::to_string(seed) + "_" + stamp;
 }
 
 }  // namespace masa::learner

@@ -5,6 +5,7 @@
 // do not count: they are written before the learner starts.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 namespace masa::learner {
@@ -13,5 +14,9 @@ namespace masa::learner {
 // another directory) when `dir` holds checkpoint.bin, sac_state.bin, off_policy_state.bin or a
 // non-empty metrics.csv. A missing or empty directory passes.
 void refuseRunDirInUse(const std::string& dir);
+
+// A new run's directory when none is given: runs/<name>_<seed>_<local time YYYYmmdd-HHMMSS>, so that
+// running the same command again starts a new run beside the last one instead of being refused.
+std::string defaultRunDir(const std::string& name, uint64_t seed);
 
 }  // namespace masa::learner

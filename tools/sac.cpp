@@ -8,6 +8,7 @@
 
 #include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
+#include "learner/run_directory.hpp"
 #include "learner/sac/sac_run.hpp"
 
 using namespace masa;
@@ -25,7 +26,7 @@ int main(int argc, char** argv) {
   app.add_option("--steps", steps, "environment steps (default: sac.env_steps)")->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "seed of everything random in the run (default: the config's)")->check(CLI::NonNegativeNumber);
   app.add_option("--resume", resume, "run directory to go on from (its config.yaml and sac_state.bin; --steps may raise the total)");
-  app.add_option("--out", run_dir, "run directory (default runs/<task>_sac_<method>_<seed>)");
+  app.add_option("--out", run_dir, "run directory (default runs/<task>_sac_<method>_<seed>_<time>)");
   app.add_option("--recipe", recipe, "a recipe of configs/recipes/ (or a YAML file) for the env section, before --set");
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set sac.n_step=3");
   app.add_option("--configs", configs, "configs directory")->capture_default_str();
@@ -53,7 +54,7 @@ int main(int argc, char** argv) {
     if (steps > 0) all.push_back("sac.env_steps=" + std::to_string(steps));
     if (seed >= 0) all.push_back("seed=" + std::to_string(seed));
     const config::RunConfig rc = config::loadRunConfig(configs, all);
-    if (run_dir.empty()) run_dir = "runs/" + rc.task + "_sac_" + method + "_" + std::to_string(rc.seed);
+    if (run_dir.empty()) run_dir = learner::defaultRunDir(rc.task + "_sac_" + method, rc.seed);
     sac::SacRunOptions o;
     o.run_dir = run_dir;
     o.verbose = !quiet;

@@ -27,6 +27,7 @@
 #include "common/transport/local_bus.hpp"
 #include "common/transport/transport.hpp"
 #include "learner/learner.hpp"
+#include "learner/run_directory.hpp"
 #include "learner/sac/off_policy_rule.hpp"
 
 namespace {
@@ -47,7 +48,7 @@ int main(int argc, char** argv) {
   std::string bus_kind = "local";
   app.add_option("--set", overrides, "key.path=value override (repeatable), e.g. --set task=a1_beam");
   app.add_option("--configs", configs, "configs directory")->capture_default_str();
-  app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_<seed>_inprocess)");
+  app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_inprocess_<seed>_<time>)");
   app.add_option("--recipe", recipe, "a recipe of configs/recipes/ (or a YAML file), applied before --set");
   app.add_option("--updates", updates, "PPO updates to make in total (default: ppo.max_updates)")
       ->check(CLI::PositiveNumber);
@@ -74,8 +75,7 @@ int main(int argc, char** argv) {
     const auto rc = masa::config::loadRunConfig(configs, overrides, resume.empty() ? "" : resume + "/config.yaml");
     if (updates == 0) updates = rc.ppo.max_updates;
     if (run_dir.empty())
-      run_dir = "runs/" + rc.task + "_" + masa::model::methodName(rc.method) + "_" + std::to_string(rc.seed) +
-                "_inprocess";
+      run_dir = masa::learner::defaultRunDir(rc.task + "_" + masa::model::methodName(rc.method) + "_inprocess", rc.seed);
     std::unique_ptr<masa::transport::MessageBus> bus;
     if (bus_kind == "memq") bus = std::make_unique<masa::transport::Transport>("memq://", std::nullopt);
     else bus = std::make_unique<masa::transport::LocalBus>();

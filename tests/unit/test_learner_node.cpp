@@ -11,6 +11,7 @@
 #include <iterator>
 #include <thread>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -23,6 +24,7 @@
 #include "common/transport/message_auth.hpp"
 #include "actors/rollout_chunker.hpp"
 #include "learner/learner.hpp"
+#include "learner/run_directory.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 #include "masa/lcmt_learner_stats.hpp"
 #include "masa/lcmt_policy_params.hpp"
@@ -358,6 +360,13 @@ TEST(LearnerNode, AFreshRunInADirectoryThatHoldsARunIsRefusedAndTheRunIsUntouche
   std::ofstream(dir / "job_roster") << "launcher's file\n";
   EXPECT_NO_THROW(Learner(rc, options(dir, 10)));
   fs::remove_all(dir);
+}
+
+// Without --run-dir a run gets runs/<name>_<seed>_<time>: the same command run again starts a new
+// run beside the last instead of being refused by the guard above.
+TEST(RunDirectory, TheDefaultNameCarriesTheSeedAndTheTimeOfTheStart) {
+  const std::string dir = defaultRunDir("a1_beam_masa", 7);
+  EXPECT_TRUE(std::regex_match(dir, std::regex("runs/a1_beam_masa_7_20[0-9]{6}-[0-9]{6}"))) << dir;
 }
 
 // kill -9 of the learner between two checkpoints: metrics.csv has rows for updates the checkpoint
