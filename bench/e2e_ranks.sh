@@ -34,8 +34,9 @@ MASA_LCM_URL="${MASA_LCM_URL:-udpm://239.255.76.67:$((7600 + RANDOM % 50 * 8))?t
   --set runner.eval_every=0 --set runner.plot_every=0 --set "ppo.max_policy_lag=$lag" "${sets[@]+"${sets[@]}"}" \
   > "$out/train.log" 2>&1 ||
   { echo "e2e_ranks: $task ranks $ranks actors $actors FAILED (see $out/train.log)"; exit 1; }
+median() { sort -g | awk '{ v[NR] = $1 } END { print NR ? (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) : "nan" }'; }
 fps=$(awk -F, -v w="$warmup" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "fps") c = i; next } $1 > w { print $c }' \
-  "$out/run/metrics.csv" | sort -g | awk '{ v[NR] = $1 } END { print NR ? (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) : "nan" }')
+  "$out/run/metrics.csv" | median)
 # The wall-clock rate over the measured updates: the honest number when update times alternate
 # (with ppo.max_policy_lag 1 a short update follows a long one); the median of per-update fps is
 # kept beside it.
@@ -45,10 +46,10 @@ dropped=$(tail -n 1 "$out/run/metrics.csv" | awk -F, -v h="$(head -n 1 "$out/run
   'BEGIN { n = split(h, c, ","); for (i = 1; i <= n; i++) if (c[i] == "dropped_chunks") k = i } { print k ? $k : "?" }')
 # Rank 0's progress lines: how long each measured update learned and waited for its batch (a
 # learner that mostly waits is short of actors; two modes of a lag-1 pipeline show as two sizes).
-timing=$(sed -n 's|^update \([0-9]*\)/.* learn \([0-9.]*\)s waited \([0-9.]*\)s.*|\1 \2 \3|p' "$out/train.log" |
-  awk -v w="$warmup" '$1 > w { n++; l[n] = $2; q[n] = $3 }
-    function med(a, n,   i, j, t) { for (i = 2; i <= n; i++) for (j = i; j > 1 && a[j - 1] > a[j]; j--) { t = a[j]; a[j] = a[j - 1]; a[j - 1] = t }
-                                     return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
-    END { if (n) printf "; learner: learn %.3fs, waited %.3fs an update (medians)", med(l, n), med(q, n) }')
+measured=$(sed -n 's|^update \([0-9]*\)/.* learn \([0-9.]*\)s waited \([0-9.]*\)s.*|\1 \2 \3|p' "$out/train.log" |
+  awk -v w="$warmup" '$1 > w { print $2, $3 }')
+timing=""
+[ -n "$measured" ] && timing=$(printf '; learner: learn %.3fs, waited %.3fs an update (medians)' \
+  "$(cut -d' ' -f1 <<< "$measured" | median)" "$(cut -d' ' -f2 <<< "$measured" | median)")
 printf 'e2e_ranks: %s ranks %d actors %d x %d envs, threads %d, lag %d: fps %.0f (wall clock, updates %d-%d; median of updates %.0f), chunks dropped %s%s\n' \
   "$task" "$ranks" "$actors" "$envs" "$threads" "$lag" "$mean" "$warmup" "$updates" "$fps" "$dropped" "$timing"
