@@ -42,7 +42,7 @@ void expectRefusedNaming(const char* variable, const std::string& value, const s
 
 TEST(EnvironmentDirectories, MasaConfigsThatNamesNoDirectoryIsRefusedNamingIt) {
   const std::string file = std::string(MASA_SOURCE_DIR) + "/CMakeLists.txt";
-  for (const std::string bad : {std::string("/no/such/configs"), file, std::string()}) {
+  for (const std::string& bad : {std::string("/no/such/configs"), file, std::string()}) {
     ScopedEnv env("MASA_CONFIGS", bad.c_str());
     expectRefusedNaming("MASA_CONFIGS", bad, [] { config::defaultConfigsDir(); });
   }

@@ -418,7 +418,7 @@ TEST(RolloutAssembler, AChunkNamingOtherRewardTermsThanTheTasksIsDropped) {
   config.term_names = good.term_names;
   RolloutAssembler assembler(config);
   assembler.setLearnerVersion(5);
-  for (const std::string name : std::vector<std::string>{"`touch /tmp/masa_pwned`", "alive,reward", "other"}) {
+  for (const std::string& name : std::vector<std::string>{"`touch /tmp/masa_pwned`", "alive,reward", "other"}) {
     masa::lcmt_rollout_chunk bad = good;
     bad.term_names[0] = name;
     const Verdict v = assembler.accept(bad);

@@ -47,7 +47,7 @@ std::vector<std::vector<float>> episodesByEnv(const rollout::Rollout& r) {
 // Chunker -> bytes -> assembler -> collector, everything that arrives, in env order.
 struct Pipeline {
   explicit Pipeline(const RolloutShape& s, int batch_envs)
-      : assembler(AssemblerConfig{.run_id = 5, .horizon = s.horizon, .obs_dim = s.obs_dim, .act_dim = s.act_dim}),
+      : assembler(AssemblerConfig{.run_id = 5, .horizon = s.horizon, .obs_dim = s.obs_dim, .act_dim = s.act_dim, .term_names = {}}),
         collector(CollectorConfig{.num_envs = batch_envs,
                                   .horizon = s.horizon,
                                   .obs_dim = s.obs_dim,
