@@ -29,11 +29,11 @@
 namespace masa {
 namespace {
 
-constexpr int64_t kRunId = 777;
+constexpr int64_t kRolloutRunId = 777;
 constexpr int kHorizon = 8;
 constexpr int kEpisodeSteps = 5;  // shorter than the horizon: every env finishes an episode
 
-config::RunConfig smallConfig(uint64_t seed, const std::string& task = "trifinger_lift") {
+config::RunConfig smallRolloutConfig(uint64_t seed, const std::string& task = "trifinger_lift") {
   return config::loadRunConfig(std::string(MASA_SOURCE_DIR) + "/configs",
                                {"task=" + task, "seed=" + std::to_string(seed), "ppo.horizon=" + std::to_string(kHorizon),
                                 "model.policy_hidden=[16]", "model.critic_hidden=[16]",
@@ -49,7 +49,7 @@ struct FakeLearner {
   }
   masa::lcmt_policy_params message(int64_t version, float param_shift = 0.0f) const {
     masa::lcmt_policy_params p;
-    p.run_id = kRunId;
+    p.run_id = kRolloutRunId;
     p.utime = 0;
     p.version = version;
     p.method = model::methodName(rc.method);
@@ -76,7 +76,7 @@ struct FakeLearner {
 // The learner's chunk gate, configured for this test run's dimensions (warnings off).
 learner::AssemblerConfig assemblerConfigFor(const FakeLearner& learner) {
   learner::AssemblerConfig ac;
-  ac.run_id = kRunId;
+  ac.run_id = kRolloutRunId;
   ac.horizon = kHorizon;
   ac.obs_dim = learner.spec.obsDim();
   ac.act_dim = learner.spec.actDim();
@@ -102,11 +102,11 @@ masa::lcmt_rollout_chunk decode(const std::vector<uint8_t>& bytes) {
   return c;
 }
 
-actor::ActorOptions options(int num_envs, int64_t max_rollouts) {
+actor::ActorOptions rolloutOptions(int num_envs, int64_t max_rollouts) {
   actor::ActorOptions o;
   o.actor_id = 3;
   o.num_envs = num_envs;
-  o.run_id = kRunId;
+  o.run_id = kRolloutRunId;
   o.max_rollouts = max_rollouts;
   o.threads = 2;
   o.chunk_bytes = 8000;  // small, so that a rollout is split into several chunks
@@ -116,12 +116,12 @@ actor::ActorOptions options(int num_envs, int64_t max_rollouts) {
 }
 
 TEST(ActorRollouts, ChunksFromLearnerParamsPassTheAssemblerWithAllEnvsAndEpisodes) {
-  const auto rc = smallConfig(1);
+  const auto rc = smallRolloutConfig(1);
   transport::Transport bus("memq://");
   Capture cap(bus);
   FakeLearner learner(rc, 5);
   const int E = 6;
-  actor::Actor actor(rc, options(E, 2), &bus);
+  actor::Actor actor(rc, rolloutOptions(E, 2), &bus);
   ASSERT_TRUE(bus.publish(transport::kPolicyChannel, learner.message(1)));
   EXPECT_EQ(actor.run(), 2);
   bus.drain();
@@ -164,10 +164,10 @@ TEST(ActorRollouts, ChunksFromLearnerParamsPassTheAssemblerWithAllEnvsAndEpisode
 // next one needed: here no learner answers, so each wait runs to its budget (0.05 s, then doubled
 // before any answer), and the last rollout is followed by none.
 TEST(ActorRollouts, EachRolloutsCollectTimeAndTheWaitForParametersAfterItAreKept) {
-  const auto rc = smallConfig(1);
+  const auto rc = smallRolloutConfig(1);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  actor::ActorOptions opt = options(4, 3);
+  actor::ActorOptions opt = rolloutOptions(4, 3);
   opt.await_params_s = 0.05;
   actor::Actor actor(rc, opt, &bus);
   ASSERT_TRUE(bus.publish(transport::kPolicyChannel, learner.message(1)));
@@ -181,11 +181,11 @@ TEST(ActorRollouts, EachRolloutsCollectTimeAndTheWaitForParametersAfterItAreKept
 }
 
 TEST(ActorRollouts, ParametersPublishedMidRolloutApplyFromTheNextRollout) {
-  const auto rc = smallConfig(2);
+  const auto rc = smallRolloutConfig(2);
   transport::Transport bus("memq://");
   Capture cap(bus);
   FakeLearner learner(rc, 5);
-  auto opt = options(3, 2);
+  auto opt = rolloutOptions(3, 2);
   opt.after_step = [&](int64_t seq, int t) {
     if (seq == 0 && t == 3) bus.publish(transport::kPolicyChannel, learner.message(2, 0.05f));
   };
@@ -210,11 +210,11 @@ TEST(ActorRollouts, ParametersPublishedMidRolloutApplyFromTheNextRollout) {
 }
 
 std::vector<std::vector<uint8_t>> runOnce(uint64_t seed, int threads) {
-  const auto rc = smallConfig(seed);
+  const auto rc = smallRolloutConfig(seed);
   transport::Transport bus("memq://");
   Capture cap(bus);
   FakeLearner learner(rc, 5);
-  auto opt = options(4, 2);
+  auto opt = rolloutOptions(4, 2);
   opt.threads = threads;
   actor::Actor actor(rc, opt, &bus);
   bus.publish(transport::kPolicyChannel, learner.message(1));
@@ -240,18 +240,18 @@ TEST(ActorRollouts, DifferentSeedGivesDifferentChunks) {
 }
 
 TEST(ActorRollouts, HeartbeatNamesTheActorAndItsVersion) {
-  const auto rc = smallConfig(3, "a1_beam");
+  const auto rc = smallRolloutConfig(3, "a1_beam");
   transport::Transport bus("memq://");
   Capture cap(bus);
   FakeLearner learner(rc, 5);
-  actor::Actor actor(rc, options(2, 1), &bus);
+  actor::Actor actor(rc, rolloutOptions(2, 1), &bus);
   bus.publish(transport::kPolicyChannel, learner.message(4));
   actor.run();
   bus.drain();
   ASSERT_GE(cap.heartbeats.size(), 2u) << "one at start, one at stop";
   EXPECT_EQ(cap.heartbeats.front().policy_version, -1) << "no parameters yet at start";
   const auto& last = cap.heartbeats.back();
-  EXPECT_EQ(last.run_id, kRunId);
+  EXPECT_EQ(last.run_id, kRolloutRunId);
   EXPECT_EQ(last.actor_id, 3);
   EXPECT_EQ(last.num_envs, 2);
   EXPECT_EQ(last.policy_version, 4);
@@ -264,11 +264,11 @@ TEST(ActorRollouts, HeartbeatNamesTheActorAndItsVersion) {
 // it, between the steps of a rollout too (it acts with them from the next rollout), and again for a
 // repeat (its acknowledgement may have been lost); a rejected message is not acknowledged.
 TEST(ActorRollouts, ParametersAreAcknowledgedAtOnceInAHeartbeatAndARejectedMessageIsNot) {
-  const auto rc = smallConfig(3, "a1_beam");
+  const auto rc = smallRolloutConfig(3, "a1_beam");
   transport::Transport bus("memq://");
   Capture cap(bus);
   FakeLearner learner(rc, 5);
-  auto o = options(2, -1);
+  auto o = rolloutOptions(2, -1);
   o.heartbeat_interval_s = 3600;  // no heartbeat but the acknowledgements
   o.after_step = [&](int64_t rollout, int t) {
     if (rollout == 0 && t == 1) bus.publish(transport::kPolicyChannel, learner.message(5));
@@ -307,12 +307,12 @@ TEST(ActorRollouts, ParametersAreAcknowledgedAtOnceInAHeartbeatAndARejectedMessa
 }
 
 TEST(ActorRollouts, ParametersOfAnotherRunOrTaskAreIgnored) {
-  const auto rc = smallConfig(4);
+  const auto rc = smallRolloutConfig(4);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  actor::Actor actor(rc, options(1, 1), &bus);
+  actor::Actor actor(rc, rolloutOptions(1, 1), &bus);
   auto other_run = learner.message(1);
-  other_run.run_id = kRunId + 1;
+  other_run.run_id = kRolloutRunId + 1;
   bus.publish(transport::kPolicyChannel, other_run);
   auto other_task = learner.message(1);
   other_task.task = "a1_beam";
@@ -325,10 +325,10 @@ TEST(ActorRollouts, ParametersOfAnotherRunOrTaskAreIgnored) {
 // One rejected message must not outlive itself: an actor that remembered the version of a message
 // it rejected (2^51, with an unknown task) ignored every real update after it, for good.
 TEST(ActorRollouts, ARejectedParameterMessageIsNotRememberedAndTheLearnersNextParametersAreTaken) {
-  const auto rc = smallConfig(4);
+  const auto rc = smallRolloutConfig(4);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  actor::Actor actor(rc, options(1, -1), &bus);
+  actor::Actor actor(rc, rolloutOptions(1, -1), &bus);
   auto hostile = learner.message(int64_t{1} << 51);
   hostile.task = "no_such_task";
   bus.publish(transport::kPolicyChannel, hostile);
@@ -349,10 +349,10 @@ TEST(ActorRollouts, ARejectedParameterMessageIsNotRememberedAndTheLearnersNextPa
 // Versions are only believed as plausible steps: a message a million versions ahead of the actor
 // is rejected (and not remembered), so the learner's real next version is still taken.
 TEST(ActorRollouts, AVersionFarAheadOfTheActorsIsRejectedAndTheRealNextVersionIsTaken) {
-  const auto rc = smallConfig(4);
+  const auto rc = smallRolloutConfig(4);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  actor::Actor actor(rc, options(1, -1), &bus);
+  actor::Actor actor(rc, rolloutOptions(1, -1), &bus);
   bus.publish(transport::kPolicyChannel, learner.message(1));
   ASSERT_TRUE(actor.pollParams(10));
   bus.publish(transport::kPolicyChannel, learner.message(1 + 2'000'000, 0.5f));
@@ -365,7 +365,7 @@ TEST(ActorRollouts, AVersionFarAheadOfTheActorsIsRejectedAndTheRealNextVersionIs
   ASSERT_TRUE(actor.collectAndPublish());
   EXPECT_EQ(actor.policyVersion(), 2);
   // A fresh actor (no parameters yet) measures from version 0.
-  actor::Actor fresh(rc, options(1, -1), &bus);
+  actor::Actor fresh(rc, rolloutOptions(1, -1), &bus);
   bus.publish(transport::kPolicyChannel, learner.message(int64_t{1} << 49));
   EXPECT_FALSE(fresh.pollParams(10));
   bus.publish(transport::kPolicyChannel, learner.message(3));
@@ -378,10 +378,10 @@ TEST(ActorRollouts, AVersionFarAheadOfTheActorsIsRejectedAndTheRealNextVersionIs
 // "older") for good while the learner dropped its chunks as future_version: a live fuzz run
 // stalled this way. The learner's repeats below the actor's version now take it back.
 TEST(ActorRollouts, AVersionTheLearnerNeverPublishedIsGivenUpWhenTheLearnerKeepsPublishingItsOwn) {
-  const auto rc = smallConfig(4);
+  const auto rc = smallRolloutConfig(4);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  actor::Actor actor(rc, options(1, -1), &bus);
+  actor::Actor actor(rc, rolloutOptions(1, -1), &bus);
   bus.publish(transport::kPolicyChannel, learner.message(7));
   ASSERT_TRUE(actor.pollParams(10));
   bus.publish(transport::kPolicyChannel, learner.message(985, 0.25f));  // a bit flip in the version
@@ -412,10 +412,10 @@ TEST(ActorRollouts, AVersionTheLearnerNeverPublishedIsGivenUpWhenTheLearnerKeeps
 }
 
 TEST(ActorRollouts, WholeModelParametersAreAcceptedAsWellAsThePolicyPrefix) {
-  const auto rc = smallConfig(4);
+  const auto rc = smallRolloutConfig(4);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  actor::Actor actor(rc, options(1, 1), &bus);
+  actor::Actor actor(rc, rolloutOptions(1, 1), &bus);
   auto whole = learner.message(1);
   whole.num_params = learner.model.params().size();
   whole.params.assign(learner.model.params().values().data(),
@@ -427,10 +427,10 @@ TEST(ActorRollouts, WholeModelParametersAreAcceptedAsWellAsThePolicyPrefix) {
 }
 
 TEST(ActorRollouts, StartWithoutLearnerActsWithVersionZero) {
-  const auto rc = smallConfig(5);
+  const auto rc = smallRolloutConfig(5);
   transport::Transport bus("memq://");
   Capture cap(bus);
-  auto opt = options(2, 1);
+  auto opt = rolloutOptions(2, 1);
   opt.start_without_learner = true;
   actor::Actor actor(rc, opt, &bus);
   EXPECT_EQ(actor.run(), 1);
@@ -442,11 +442,11 @@ TEST(ActorRollouts, StartWithoutLearnerActsWithVersionZero) {
 // Restart detection rests on the incarnation, not on the numbering: both processes number their
 // rollouts 0, 1, and the second is neither taken for replays of the first nor for an outage.
 TEST(ActorRollouts, ARestartedActorIsANewIncarnationNumberedFromZeroAndIsAccepted) {
-  const auto rc = smallConfig(7);
+  const auto rc = smallRolloutConfig(7);
   transport::Transport bus("memq://");
   Capture cap(bus);
   FakeLearner learner(rc, 5);
-  auto opt = options(2, 2);
+  auto opt = rolloutOptions(2, 2);
   opt.incarnation = actor::kIncarnationFromClock;  // what masa_actor does
   int64_t incarnation[2];
   for (int process = 0; process < 2; ++process) {  // the same actor id, twice: killed and restarted
@@ -470,11 +470,11 @@ TEST(ActorRollouts, ARestartedActorIsANewIncarnationNumberedFromZeroAndIsAccepte
 }
 
 TEST(ActorRollouts, FaultInjectionThrowsAwayTheRequestedShareOfChunksReproducibly) {
-  const auto rc = smallConfig(8, "a1_beam");
+  const auto rc = smallRolloutConfig(8, "a1_beam");
   auto run = [&](uint64_t drop_seed) {
     transport::Transport bus("memq://");
     Capture cap(bus);
-    auto opt = options(6, 6);
+    auto opt = rolloutOptions(6, 6);
     opt.chunk_bytes = 1;  // one environment per chunk: 36 chunks
     opt.start_without_learner = true;
     opt.drop_chunks_percent = 40;
@@ -499,11 +499,11 @@ TEST(ActorRollouts, FaultInjectionThrowsAwayTheRequestedShareOfChunksReproducibl
 }
 
 TEST(ActorRollouts, StopFlagEndsTheRunBetweenSteps) {
-  const auto rc = smallConfig(6);
+  const auto rc = smallRolloutConfig(6);
   transport::Transport bus("memq://");
   Capture cap(bus);
   std::atomic<bool> stop{false};
-  auto opt = options(2, -1);
+  auto opt = rolloutOptions(2, -1);
   opt.start_without_learner = true;
   opt.stop = &stop;
   opt.after_step = [&](int64_t seq, int t) {
@@ -516,9 +516,9 @@ TEST(ActorRollouts, StopFlagEndsTheRunBetweenSteps) {
 // A fast actor waits (bounded) for the learner's next version instead of collecting rollouts the
 // learner would drop as stale; with no learner the wait expires and collection goes on.
 TEST(ActorRollouts, BetweenRolloutsTheActorWaitsBoundedForNewerParameters) {
-  const auto rc = smallConfig(8);
+  const auto rc = smallRolloutConfig(8);
   transport::Transport bus("memq://");
-  auto opt = options(2, 3);
+  auto opt = rolloutOptions(2, 3);
   opt.start_without_learner = true;
   opt.await_params_s = 0.4;
   actor::Actor actor(rc, opt, &bus);
@@ -531,10 +531,10 @@ TEST(ActorRollouts, BetweenRolloutsTheActorWaitsBoundedForNewerParameters) {
 // With ppo.max_policy_lag 1 the actor collects its next rollout while the learner learns from the
 // last (no wait after the first rollout), but not a third before the first is answered.
 TEST(ActorRollouts, WithPolicyLagOneTheActorCollectsOneRolloutAheadAndWaitsBeforeTheNext) {
-  auto rc = smallConfig(8);
+  auto rc = smallRolloutConfig(8);
   rc.ppo.max_policy_lag = 1;
   transport::Transport bus("memq://");
-  auto opt = options(2, 3);
+  auto opt = rolloutOptions(2, 3);
   opt.start_without_learner = true;
   opt.await_params_s = 1.0;
   actor::Actor actor(rc, opt, &bus);
@@ -546,10 +546,10 @@ TEST(ActorRollouts, WithPolicyLagOneTheActorCollectsOneRolloutAheadAndWaitsBefor
 }
 
 TEST(ActorRollouts, NewerParametersEndTheWaitAtOnce) {
-  const auto rc = smallConfig(9);
+  const auto rc = smallRolloutConfig(9);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  auto opt = options(2, 2);
+  auto opt = rolloutOptions(2, 2);
   opt.await_params_s = 30.0;  // a missed wake-up would show as a 30 s test
   // Each rollout's chunk is answered with the next version, as a learner does after its update.
   int64_t next = 1;
@@ -566,10 +566,10 @@ TEST(ActorRollouts, NewerParametersEndTheWaitAtOnce) {
 // An actor whose learner is gone stops publishing and exits (issue #9: it used to simulate and
 // publish forever). Here the learner sends its parameters once and is never heard again.
 TEST(ActorRollouts, AnActorWhoseLearnerFallsSilentStopsPublishingAndExits) {
-  const auto rc = smallConfig(10);
+  const auto rc = smallRolloutConfig(10);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  auto opt = options(2, 20);
+  auto opt = rolloutOptions(2, 20);
   opt.await_params_s = 0.05;
   opt.learner_silence_pause_s = 0.3;
   opt.learner_silence_exit_s = 0.8;
@@ -589,10 +589,10 @@ TEST(ActorRollouts, AnActorWhoseLearnerFallsSilentStopsPublishingAndExits) {
 
 // The learner's periodic repeat of the parameters the actor already holds keeps it publishing.
 TEST(ActorRollouts, TheLearnersRepeatedParametersKeepTheActorGoing) {
-  const auto rc = smallConfig(11);
+  const auto rc = smallRolloutConfig(11);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  auto opt = options(2, 6);
+  auto opt = rolloutOptions(2, 6);
   opt.await_params_s = 0.15;
   opt.await_params_max_s = 0.15;  // this fake repeats only when a rollout comes: waits that grow
                                   // (no answer ever comes) would starve it; a real learner repeats on its own
@@ -608,10 +608,10 @@ TEST(ActorRollouts, TheLearnersRepeatedParametersKeepTheActorGoing) {
 // docs/inputs.md gap 10: a message at the actor's own version was taken as the learner's repeat
 // unchecked; a malformed one (a NaN parameter) now is refused, counted, and keeps nothing going.
 TEST(ActorRollouts, AMalformedMessageAtTheActorsVersionIsRefusedAndDoesNotCountAsTheLearner) {
-  const auto rc = smallConfig(12);
+  const auto rc = smallRolloutConfig(12);
   transport::Transport bus("memq://");
   FakeLearner learner(rc, 5);
-  auto opt = options(2, 20);
+  auto opt = rolloutOptions(2, 20);
   opt.await_params_s = 0.05;
   opt.learner_silence_pause_s = 0.3;
   opt.learner_silence_exit_s = 0.6;

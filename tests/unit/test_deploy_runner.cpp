@@ -32,11 +32,11 @@ using test::stateOf;
 
 const std::string kPolicy = std::string(MASA_SOURCE_DIR) + "/tasks/a1_beam/policy/policy.bin";
 
-struct Fixture {
+struct RunnerFixture {
   policy::LoadedPolicy lp = policy::loadPolicyFile(kPolicy);
   task::TaskFactory factory{task::taskCatalog(), lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source};
   std::unique_ptr<task::Task> sim = factory.create();
-  Fixture() {
+  RunnerFixture() {
     Rng rng(0);
     sim->reset(rng);
   }
@@ -66,7 +66,7 @@ std::vector<Sent> drive(PolicyRunner& r, task::Task& sim, int64_t from_us, int64
 }
 
 TEST(DeployRunner, ObservationFromAStateMessageEqualsTheTasksOwnInSimulation) {
-  Fixture f;
+  RunnerFixture f;
   std::unique_ptr<task::Task> robot_side = f.factory.create();  // never reset, never stepped
   Rng rng(3);
   std::normal_distribution<float> noise(0.0f, 0.5f);
@@ -88,7 +88,7 @@ TEST(DeployRunner, ObservationFromAStateMessageEqualsTheTasksOwnInSimulation) {
 // The runner freezes the policy it runs (its weights are packed once for the agent columns) and
 // acts with the bits of the same policy unfrozen, as the actors and the evaluation run it.
 TEST(DeployRunner, FreezesItsPolicyAndActsWithTheBitsOfTheUnfrozenPolicy) {
-  Fixture f;
+  RunnerFixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
   EXPECT_THROW(r.policy().params().values(), std::exception);
   EXPECT_EQ(r.policy().params().size(), f.lp.model->policyParamCount()) << "the policy half only: no critic on the robot";
@@ -143,7 +143,7 @@ TEST(DeployRunner, HumanoidJointCommandIsTheTasksMotorTorqueAndItsObservationThe
 }
 
 TEST(DeployRunner, StaleStateGivesTheSafeCommandWithinTheBoundAndSaysWhy) {
-  Fixture f;
+  RunnerFixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
   int64_t utime = 0;
   // 2 s of state at 200 Hz: calibration, then the policy.
@@ -167,7 +167,7 @@ TEST(DeployRunner, StaleStateGivesTheSafeCommandWithinTheBoundAndSaysWhy) {
 }
 
 TEST(DeployRunner, RepeatedStateIsStaleToo) {
-  Fixture f;
+  RunnerFixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
   int64_t utime = 0;
   drive(r, *f.sim, 0, 1000000, 5000, utime);
@@ -185,7 +185,7 @@ TEST(DeployRunner, RepeatedStateIsStaleToo) {
 // docs/inputs.md gap 2: one state with a far-future utime, from anyone on the robot's LAN, made
 // every later real state a "repeat", and the watchdog latched the safe command.
 TEST(DeployRunner, OneForgedFarFutureStateDoesNotStopTheRobot) {
-  Fixture f;
+  RunnerFixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
   int64_t utime = 0;
   drive(r, *f.sim, 0, 1500000, 5000, utime);
@@ -203,7 +203,7 @@ TEST(DeployRunner, OneForgedFarFutureStateDoesNotStopTheRobot) {
 // lengths, truncation, splices), through the wire guard into the runner, interleaved with the real
 // ones: no crash, and every command finite and within the joint range and the gain bounds.
 TEST(DeployRunner, MutatedStateMessagesNeverGiveACommandOutsideTheLimits) {
-  Fixture f;
+  RunnerFixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
   const DeployConfig c = testConfig();
   int64_t utime = 0, delivered = 0, refused = 0;
@@ -243,7 +243,7 @@ TEST(DeployRunner, MutatedStateMessagesNeverGiveACommandOutsideTheLimits) {
 
 TEST(DeployRunner, NonFiniteStateGivesTheSafeCommandAtOnce) {
   for (const char* field : {"joint_position", "joint_velocity", "base_qx"}) {
-    Fixture f;
+    RunnerFixture f;
     PolicyRunner r(f.lp, testConfig(), 1);
     int64_t utime = 0;
     drive(r, *f.sim, 0, 1500000, 5000, utime);
@@ -263,7 +263,7 @@ TEST(DeployRunner, NonFiniteStateGivesTheSafeCommandAtOnce) {
 }
 
 TEST(DeployRunner, EmergencyStopOnTheOrientationLimit) {
-  Fixture f;
+  RunnerFixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
   int64_t utime = 0;
   drive(r, *f.sim, 0, 1500000, 5000, utime);
@@ -281,7 +281,7 @@ TEST(DeployRunner, EmergencyStopOnTheOrientationLimit) {
 // measured pose for the crouch pose at no more than crouch_max_rate, reach it, and stay there with
 // the crouch gains, latched, even when the state then stops.
 TEST(DeployRunner, EmergencyCrouchReachesTheCrouchPoseWithinItsRate) {
-  Fixture f;
+  RunnerFixture f;
   DeployConfig c = testConfig();
   c.emergency_response = EmergencyResponse::kCrouch;
   c.crouch_pose.clear();
@@ -342,7 +342,7 @@ TEST(DeployRunner, EmergencyCrouchReachesTheCrouchPoseWithinItsRate) {
 }
 
 TEST(DeployRunner, CrouchPoseOfTheWrongSizeOrOutsideTheLimitsIsRefused) {
-  Fixture f;
+  RunnerFixture f;
   DeployConfig c = testConfig();
   c.emergency_response = EmergencyResponse::kCrouch;
   c.crouch_pose = {0.0, 1.2, -2.4};
@@ -369,7 +369,7 @@ TEST(DeployRunner, CrouchPoseOfTheWrongSizeOrOutsideTheLimitsIsRefused) {
 // Every command of a runner with random networks, on random states, keeps the limits.
 TEST(DeployRunner, LimitsHoldOnEveryCommandForRandomPolicies) {
   for (uint64_t seed : {1, 2, 3}) {
-    Fixture f;
+    RunnerFixture f;
     Rng rng(seed);
     std::normal_distribution<float> w(0.0f, 3.0f);  // large weights: actions far beyond [-1, 1]
     for (int i = 0; i < f.lp.model->params().size(); ++i) f.lp.model->params().values()[i] = w(rng);
@@ -422,7 +422,7 @@ TEST(DeployRunner, LimitsHoldOnEveryCommandForRandomPolicies) {
 }
 
 TEST(DeployRunner, CalibrationRampNeverExceedsItsRateAndReachesTheNominalPose) {
-  Fixture f;
+  RunnerFixture f;
   DeployConfig c = testConfig();
   c.calibration_max_rate = 0.5;
   PolicyRunner r(f.lp, c, 1);
@@ -459,7 +459,7 @@ TEST(DeployRunner, CalibrationRampNeverExceedsItsRateAndReachesTheNominalPose) {
 
 TEST(DeployRunner, ControlStepAllocatesNothing) {
   if (!test::allocationCountingEnabled()) GTEST_SKIP() << "allocation counting disabled (sanitizer)";
-  Fixture f;
+  RunnerFixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
   int64_t utime = 0;
   drive(r, *f.sim, 0, 1500000, 5000, utime);
@@ -482,7 +482,7 @@ TEST(DeployRunner, ControlStepAllocatesNothing) {
 
 // The cache warm-up before a command (realtime.warm_up_us) changes no command.
 TEST(DeployRunner, WarmUpChangesNoCommand) {
-  Fixture f, g;
+  RunnerFixture f, g;
   PolicyRunner plain(f.lp, testConfig(), 1), warmed(g.lp, testConfig(), 1);
   masa::lcmt_robot_command a = plain.makeCommand(), b = warmed.makeCommand();
   Rng rng(4);

@@ -27,19 +27,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratchDir(const std::string& name) {
+fs::path integrityDir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("masa_file_integrity_" + std::to_string(::getpid())) / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
 }
 
-std::string slurp(const fs::path& p) {
+std::string fileBytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-void spit(const fs::path& p, const std::string& bytes) {
+void writeBytes(const fs::path& p, const std::string& bytes) {
   std::ofstream out(p, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
@@ -67,7 +67,7 @@ struct QuietStderr {
   ~QuietStderr() { ::testing::internal::GetCapturedStderr(); }
 };
 
-config::RunConfig smallConfig(const std::string& method) {
+config::RunConfig smallA1Config(const std::string& method) {
   return config::loadRunConfig(config::defaultConfigsDir(), {"task=a1_beam", "method=" + method, "model.policy_hidden=[16]",
                                                              "model.critic_hidden=[16]"});
 }
@@ -84,15 +84,15 @@ struct SmallModel {
 // ---- policy files: what masa_eval, masa_export and masa_deploy read ----
 
 TEST(PolicyFileIntegrity, ABitFlippedAtAnyByteIsRefusedNamingTheFile) {
-  const fs::path dir = scratchDir("policy_every_byte");
-  const config::RunConfig rc = smallConfig("masa");
+  const fs::path dir = integrityDir("policy_every_byte");
+  const config::RunConfig rc = smallA1Config("masa");
   SmallModel m(rc);
   const fs::path good = dir / "policy.bin", bad = dir / "damaged.bin";
   policy::savePolicyFile(good.string(), rc, m.model);
-  const std::string bytes = slurp(good);
+  const std::string bytes = fileBytes(good);
   const auto load = [](const std::string& p) { policy::loadPolicyFile(p); };
   ASSERT_EQ(refusal(load, good), "");
-  spit(bad, bytes);
+  writeBytes(bad, bytes);
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     fuzz::flipBitInFile(bad.string(), i);
     const std::string why = refusal(load, bad);
@@ -100,20 +100,20 @@ TEST(PolicyFileIntegrity, ABitFlippedAtAnyByteIsRefusedNamingTheFile) {
     ASSERT_EQ(why.rfind(bad.string() + ": ", 0), 0u) << why;
     fuzz::flipBitInFile(bad.string(), i);
   }
-  spit(bad, flipped(bytes, bytes.size() / 2));
+  writeBytes(bad, flipped(bytes, bytes.size() / 2));
   EXPECT_EQ(refusal(load, bad), bad.string() + ": checksum mismatch (file corrupted or truncated)");
 }
 
 TEST(PolicyFileIntegrity, ABitFlippedInTheShippedA1PolicyIsRefused) {
   const fs::path shipped = fs::path(MASA_SOURCE_DIR) / "tasks/a1_beam/policy/policy.bin";
-  const std::string bytes = slurp(shipped);
-  const fs::path bad = scratchDir("shipped") / "policy.bin";
+  const std::string bytes = fileBytes(shipped);
+  const fs::path bad = integrityDir("shipped") / "policy.bin";
   const auto load = [](const std::string& p) { policy::loadPolicyFile(p); };
   ::testing::internal::CaptureStderr();
   EXPECT_EQ(refusal(load, shipped), "");
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << "the shipped policy is sealed: no warning";
   int checked = 0;
-  spit(bad, bytes);
+  writeBytes(bad, bytes);
   for (std::size_t i = 0; i < bytes.size(); i += (i < 512 || i + 512 > bytes.size()) ? 1 : 409, ++checked) {
     fuzz::flipBitInFile(bad.string(), i);
     ASSERT_NE(refusal(load, bad), "") << "byte " << i;
@@ -123,16 +123,16 @@ TEST(PolicyFileIntegrity, ABitFlippedInTheShippedA1PolicyIsRefused) {
 }
 
 TEST(PolicyFileIntegrity, AnUnsealedPolicyFromBeforeTheSealLoadsWithAWarningOrIsRefusedWhenSignedIsRequired) {
-  const fs::path dir = scratchDir("policy_legacy");
-  const config::RunConfig rc = smallConfig("sa");
+  const fs::path dir = integrityDir("policy_legacy");
+  const config::RunConfig rc = smallA1Config("sa");
   SmallModel m(rc);
   policy::savePolicyFile((dir / "sealed.bin").string(), rc, m.model);
   // The old format is the seal's payload: what stands after the 52-byte header and the kind.
-  const std::string sealed = slurp(dir / "sealed.bin");
+  const std::string sealed = fileBytes(dir / "sealed.bin");
   const std::size_t payload_at = 52 + 4 + policy::kPolicyFileKind.name.size();
   ASSERT_EQ(sealed.compare(payload_at, 8, "MASAPOL1"), 0);
   const fs::path old = dir / "old_policy.bin";
-  spit(old, sealed.substr(payload_at));
+  writeBytes(old, sealed.substr(payload_at));
   ASSERT_TRUE(policy::isPolicyFile(old.string()));
   ::testing::internal::CaptureStderr();
   const policy::LoadedPolicy p = policy::loadPolicyFile(old.string());
@@ -149,17 +149,17 @@ TEST(PolicyFileIntegrity, AnUnsealedPolicyFromBeforeTheSealLoadsWithAWarningOrIs
 }
 
 TEST(PolicyFileIntegrity, RandomMutationsNeverCrashTheReaderNorGetAccepted) {
-  const fs::path dir = scratchDir("policy_fuzz");
-  const config::RunConfig rc = smallConfig("masa");
+  const fs::path dir = integrityDir("policy_fuzz");
+  const config::RunConfig rc = smallA1Config("masa");
   SmallModel m(rc);
   policy::savePolicyFile((dir / "policy.bin").string(), rc, m.model);
-  const std::string bytes = slurp(dir / "policy.bin");
+  const std::string bytes = fileBytes(dir / "policy.bin");
   const auto load = [](const std::string& p) { policy::loadPolicyFile(p); };
   std::mt19937_64 rng(33);
   for (int i = 0; i < 300; ++i) {
     const fuzz::FileMutation mut = fuzz::mutateFile(bytes, rng);
     if (mut.bytes == bytes) continue;
-    spit(dir / "mutated.bin", mut.bytes);
+    writeBytes(dir / "mutated.bin", mut.bytes);
     ASSERT_NE(refusal(load, dir / "mutated.bin"), "") << "mutation " << i << " (" << mut.what << ") was accepted";
   }
 }
@@ -167,7 +167,7 @@ TEST(PolicyFileIntegrity, RandomMutationsNeverCrashTheReaderNorGetAccepted) {
 // ---- learner checkpoints: what masa_train --resume, masa_learner and masa_eval read ----
 
 struct SmallCheckpoint {
-  SmallCheckpoint() : rc(smallConfig("masa")), m(rc), adam(m.model.params()) {
+  SmallCheckpoint() : rc(smallA1Config("masa")), m(rc), adam(m.model.params()) {
     state.run_id = 7;
     state.updates = state.version = 3;
     state.env_steps = 1234;
@@ -182,7 +182,7 @@ struct SmallCheckpoint {
 };
 
 TEST(CheckpointIntegrity, ABitFlippedAtAnyByteIsRefusedAndTheRankZeroBytesToo) {
-  const fs::path dir = scratchDir("checkpoint_every_byte");
+  const fs::path dir = integrityDir("checkpoint_every_byte");
   SmallCheckpoint ck;
   const fs::path good = dir / "checkpoint.bin", bad = dir / "damaged.bin";
   learner::writeCheckpoint(good.string(), ck.state, ck.m.model, ck.adam);
@@ -191,8 +191,8 @@ TEST(CheckpointIntegrity, ABitFlippedAtAnyByteIsRefusedAndTheRankZeroBytesToo) {
   const auto load = [&](const std::string& p) { learner::readCheckpoint(p, into.model, &into_adam); };
   ASSERT_EQ(refusal(load, good), "");
   EXPECT_EQ(into.model.params().values(), ck.m.model.params().values());
-  const std::string bytes = slurp(good);
-  spit(bad, bytes);
+  const std::string bytes = fileBytes(good);
+  writeBytes(bad, bytes);
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     fuzz::flipBitInFile(bad.string(), i);
     const std::string why = refusal(load, bad);
@@ -205,10 +205,10 @@ TEST(CheckpointIntegrity, ABitFlippedAtAnyByteIsRefusedAndTheRankZeroBytesToo) {
 }
 
 TEST(CheckpointIntegrity, RandomMutationsNeverCrashTheReaderNorGetAccepted) {
-  const fs::path dir = scratchDir("checkpoint_fuzz");
+  const fs::path dir = integrityDir("checkpoint_fuzz");
   SmallCheckpoint ck;
   learner::writeCheckpoint((dir / "checkpoint.bin").string(), ck.state, ck.m.model, ck.adam);
-  const std::string bytes = slurp(dir / "checkpoint.bin");
+  const std::string bytes = fileBytes(dir / "checkpoint.bin");
   SmallModel into(ck.rc);
   nn::Adam<float> into_adam(into.model.params());
   const auto load = [&](const std::string& p) { learner::readCheckpoint(p, into.model, &into_adam); };
@@ -216,7 +216,7 @@ TEST(CheckpointIntegrity, RandomMutationsNeverCrashTheReaderNorGetAccepted) {
   for (int i = 0; i < 300; ++i) {
     const fuzz::FileMutation mut = fuzz::mutateFile(bytes, rng);
     if (mut.bytes == bytes) continue;
-    spit(dir / "mutated.bin", mut.bytes);
+    writeBytes(dir / "mutated.bin", mut.bytes);
     ASSERT_NE(refusal(load, dir / "mutated.bin"), "") << "mutation " << i << " (" << mut.what << ") was accepted";
   }
 }
@@ -264,18 +264,18 @@ std::vector<dataset::EpisodeRecord> writeToyLog(const fs::path& path) {
 }
 
 TEST(DatasetLogIntegrity, ABitFlippedAtAnyByteNeverGetsADamagedEpisodeAccepted) {
-  const fs::path dir = scratchDir("dataset_every_byte");
+  const fs::path dir = integrityDir("dataset_every_byte");
   const auto eps = writeToyLog(dir / "toy.lcmlog");
   dataset::LogReadReport report;
   ::testing::internal::CaptureStderr();
   EXPECT_EQ(dataset::readDatasetLogs({(dir / "toy.lcmlog").string()}, &report).episodes.size(), 3u);
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << "a sealed log: no warning";
   EXPECT_EQ(report.rejectedTotal(), 0) << report.summary();
-  const std::string bytes = slurp(dir / "toy.lcmlog");
+  const std::string bytes = fileBytes(dir / "toy.lcmlog");
   int whole = 0;
   {
   QuietStderr quiet;
-  spit(dir / "damaged.lcmlog", bytes);
+  writeBytes(dir / "damaged.lcmlog", bytes);
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     fuzz::flipBitInFile((dir / "damaged.lcmlog").string(), i);
     const std::string wrong = acceptedDamage(dir / "damaged.lcmlog", eps);
@@ -287,7 +287,7 @@ TEST(DatasetLogIntegrity, ABitFlippedAtAnyByteNeverGetsADamagedEpisodeAccepted) 
   std::string second = bytes;
   const std::size_t at = bytes.size() / 2;
   second[at] ^= 1;
-  spit(dir / "one_damaged.lcmlog", second);
+  writeBytes(dir / "one_damaged.lcmlog", second);
   dataset::LogReadReport one;
   const auto d = dataset::readDatasetLogs({(dir / "one_damaged.lcmlog").string()}, &one);
   whole = static_cast<int>(d.episodes.size());
@@ -296,21 +296,21 @@ TEST(DatasetLogIntegrity, ABitFlippedAtAnyByteNeverGetsADamagedEpisodeAccepted) 
 }
 
 TEST(DatasetLogIntegrity, RandomMutationsNeverCrashTheReaderNorGetADamagedEpisodeAccepted) {
-  const fs::path dir = scratchDir("dataset_fuzz");
+  const fs::path dir = integrityDir("dataset_fuzz");
   const auto eps = writeToyLog(dir / "toy.lcmlog");
-  const std::string bytes = slurp(dir / "toy.lcmlog");
+  const std::string bytes = fileBytes(dir / "toy.lcmlog");
   std::mt19937_64 rng(35);
   QuietStderr quiet;
   for (int i = 0; i < 300; ++i) {
     const fuzz::FileMutation mut = fuzz::mutateFile(bytes, rng);
-    spit(dir / "mutated.lcmlog", mut.bytes);
+    writeBytes(dir / "mutated.lcmlog", mut.bytes);
     const std::string wrong = acceptedDamage(dir / "mutated.lcmlog", eps);
     ASSERT_EQ(wrong, "") << "mutation " << i << " (" << mut.what << "): " << wrong;
   }
 }
 
 TEST(DatasetLogIntegrity, ALogWithoutSealsIsReadWithAWarningNamingIt) {
-  const fs::path dir = scratchDir("dataset_unsealed");
+  const fs::path dir = integrityDir("dataset_unsealed");
   const dataset::EpisodeRecord e = toyEpisode(5, 6);
   {
     lcm::LogFile log((dir / "recorded.lcmlog").string(), "w");
@@ -347,15 +347,15 @@ std::string acceptedHdf5Damage(const fs::path& path, const dataset::TransitionDa
 }
 
 TEST(Hdf5ExportIntegrity, FlippedBitsAndRandomDamageNeverGetADifferentDatasetAccepted) {
-  const fs::path dir = scratchDir("hdf5");
+  const fs::path dir = integrityDir("hdf5");
   writeToyLog(dir / "toy.lcmlog");
   const dataset::TransitionDataset d = dataset::readDatasetLogs({(dir / "toy.lcmlog").string()});
   dataset::writeHdf5((dir / "toy.h5").string(), d, "toy.lcmlog");
   ::testing::internal::CaptureStderr();
   EXPECT_EQ(dataset::readHdf5((dir / "toy.h5").string()).rewards, d.rewards) << "the intact export reads back";
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << "a sealed export: no warning";
-  const std::string bytes = slurp(dir / "toy.h5");
-  spit(dir / "damaged.h5", bytes);
+  const std::string bytes = fileBytes(dir / "toy.h5");
+  writeBytes(dir / "damaged.h5", bytes);
   for (std::size_t i = 0; i < bytes.size(); i += 7) {
     fuzz::flipBitInFile((dir / "damaged.h5").string(), i);
     ASSERT_EQ(acceptedHdf5Damage(dir / "damaged.h5", d), "") << "byte " << i << " of " << bytes.size() << " flipped";
@@ -364,7 +364,7 @@ TEST(Hdf5ExportIntegrity, FlippedBitsAndRandomDamageNeverGetADifferentDatasetAcc
   std::mt19937_64 rng(37);
   for (int i = 0; i < 100; ++i) {
     const fuzz::FileMutation mut = fuzz::mutateFile(bytes, rng);
-    spit(dir / "mutated.h5", mut.bytes);
+    writeBytes(dir / "mutated.h5", mut.bytes);
     ASSERT_EQ(acceptedHdf5Damage(dir / "mutated.h5", d), "") << "mutation " << i << " (" << mut.what << ")";
   }
 }

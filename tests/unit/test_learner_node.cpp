@@ -34,7 +34,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-config::RunConfig smallConfig() {
+config::RunConfig smallLearnerConfig() {
   return config::loadRunConfig(config::defaultConfigsDir(),
                                {"task=trifinger_lift", "model.policy_hidden=[16]", "model.critic_hidden=[16]",
                                 "ppo.num_envs=8", "ppo.horizon=4", "ppo.minibatch_size=16", "ppo.mini_epochs=1"});
@@ -46,7 +46,7 @@ fs::path freshDir(const std::string& name) {
   return d;
 }
 
-LearnerOptions options(const fs::path& dir, int64_t run_id) {
+LearnerOptions nodeOptions(const fs::path& dir, int64_t run_id) {
   LearnerOptions o;
   o.url = "memq://";
   o.run_dir = dir.string();
@@ -116,9 +116,9 @@ std::vector<std::string> readLines(const fs::path& p) {
 }
 
 TEST(LearnerNode, OneBatchFromAFakeActorMakesVersionOneAndPublishesParamsStatsAndMetrics) {
-  const auto rc = smallConfig();
+  const auto rc = smallLearnerConfig();
   const fs::path dir = freshDir("update");
-  Learner learner(rc, options(dir, 77));
+  Learner learner(rc, nodeOptions(dir, 77));
   masa::lcmt_policy_params params;
   masa::lcmt_learner_stats stats;
   int num_stats = 0;
@@ -168,9 +168,9 @@ TEST(LearnerNode, OneBatchFromAFakeActorMakesVersionOneAndPublishesParamsStatsAn
 }
 
 TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTriggerAnUpdate) {
-  const auto rc = smallConfig();
+  const auto rc = smallLearnerConfig();
   const fs::path dir = freshDir("drops");
-  Learner learner(rc, options(dir, 5));
+  Learner learner(rc, nodeOptions(dir, 5));
   masa::lcmt_learner_stats stats;
   learner.transport().subscribe<masa::lcmt_learner_stats>(
       transport::kLearnerStatsChannel, [&](const masa::lcmt_learner_stats& m) { stats = m; });
@@ -224,9 +224,9 @@ TEST(LearnerNode, ChunksOfAnotherRunAndHostileChunksAreDroppedCountedAndNeverTri
 }
 
 TEST(LearnerNode, WithARunKeyChunksSignedWithAnotherKeyAreCountedUnauthenticatedAndTheRunKeysAreTrainedOn) {
-  const auto rc = smallConfig();
+  const auto rc = smallLearnerConfig();
   const fs::path dir = freshDir("auth");
-  LearnerOptions o = options(dir, 8);
+  LearnerOptions o = nodeOptions(dir, 8);
   o.run_key = transport::RunKey::random();
   Learner learner(rc, o);
   masa::lcmt_learner_stats stats;
@@ -262,13 +262,13 @@ TEST(LearnerNode, WithARunKeyChunksSignedWithAnotherKeyAreCountedUnauthenticated
 }
 
 TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv) {
-  auto rc = smallConfig();
+  auto rc = smallLearnerConfig();
   rc.runner.checkpoint_every = 1;
   const fs::path dir_a = freshDir("ckpt_a"), dir_b = freshDir("ckpt_b");
   FakeActor first(rc, 10), second(rc, 11);
   std::vector<float> params_a;
   {
-    Learner a(rc, options(dir_a, 9));
+    Learner a(rc, nodeOptions(dir_a, 9));
     first.send(a.transport(), 9, 0, 0);
     ASSERT_TRUE(stepUntilUpdate(a));
     ASSERT_TRUE(fs::exists(dir_a / "checkpoint.bin"));
@@ -279,7 +279,7 @@ TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv)
     const auto& p = a.model().params().values();
     params_a.assign(p.data(), p.data() + p.size());
   }
-  LearnerOptions o = options(dir_b, 0);  // run id from the checkpoint
+  LearnerOptions o = nodeOptions(dir_b, 0);  // run id from the checkpoint
   o.resume = true;
   Learner b(rc, o);
   EXPECT_EQ(b.runId(), 9);
@@ -303,10 +303,10 @@ TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv)
 // The progress line's "learn Xs waited Ys": an update's own time, and the time its batch kept it
 // waiting since the previous update ended (what tells a starved learner from a busy one).
 TEST(LearnerNode, TheReportSaysHowLongTheUpdateLearnedAndHowLongItWaitedForItsBatch) {
-  auto rc = smallConfig();
+  auto rc = smallLearnerConfig();
   const fs::path dir = freshDir("timing");
   FakeActor actor(rc, 10);
-  Learner a(rc, options(dir, 9));
+  Learner a(rc, nodeOptions(dir, 9));
   std::this_thread::sleep_for(std::chrono::milliseconds(150));  // the actors are late
   actor.send(a.transport(), 9, 0, 0);
   ASSERT_TRUE(stepUntilUpdate(a));
@@ -326,12 +326,12 @@ TEST(LearnerNode, TheReportSaysHowLongTheUpdateLearnedAndHowLongItWaitedForItsBa
 // first run's checkpoint stays what a resume needs and its metrics.csv keeps one run's rows (the
 // device probes of issue #30 repeated a point into one directory: three runs' rows in one file).
 TEST(LearnerNode, AFreshRunInADirectoryThatHoldsARunIsRefusedAndTheRunIsUntouched) {
-  auto rc = smallConfig();
+  auto rc = smallLearnerConfig();
   rc.runner.checkpoint_every = 1;
   const fs::path dir = freshDir("in_use");
   FakeActor actor(rc, 10);
   {
-    Learner a(rc, options(dir, 9));
+    Learner a(rc, nodeOptions(dir, 9));
     actor.send(a.transport(), 9, 0, 0);
     ASSERT_TRUE(stepUntilUpdate(a));
   }
@@ -342,7 +342,7 @@ TEST(LearnerNode, AFreshRunInADirectoryThatHoldsARunIsRefusedAndTheRunIsUntouche
   const std::string checkpoint = read(dir / "checkpoint.bin"), metrics = read(dir / "metrics.csv");
   ASSERT_FALSE(checkpoint.empty());
   try {
-    Learner b(rc, options(dir, 10));
+    Learner b(rc, nodeOptions(dir, 10));
     FAIL() << "a fresh run was started in a directory holding a run";
   } catch (const std::runtime_error& e) {
     const std::string what = e.what();
@@ -355,10 +355,10 @@ TEST(LearnerNode, AFreshRunInADirectoryThatHoldsARunIsRefusedAndTheRunIsUntouche
   // Only the metrics of a run that never checkpointed: refused as well. An empty one, or a
   // directory of the launchers' files only, is a fresh start.
   fs::remove(dir / "checkpoint.bin");
-  EXPECT_THROW(Learner(rc, options(dir, 10)), std::runtime_error);
+  EXPECT_THROW(Learner(rc, nodeOptions(dir, 10)), std::runtime_error);
   std::ofstream(dir / "metrics.csv", std::ios::trunc).flush();
   std::ofstream(dir / "job_roster") << "launcher's file\n";
-  EXPECT_NO_THROW(Learner(rc, options(dir, 10)));
+  EXPECT_NO_THROW(Learner(rc, nodeOptions(dir, 10)));
   fs::remove_all(dir);
 }
 
@@ -372,12 +372,12 @@ TEST(RunDirectory, TheDefaultNameCarriesTheSeedAndTheTimeOfTheStart) {
 // kill -9 of the learner between two checkpoints: metrics.csv has rows for updates the checkpoint
 // does not have. A resume cuts them off first, so every update has one row, in order.
 TEST(LearnerNode, ResumeCutsMetricsCsvBackToTheCheckpointsUpdate) {
-  auto rc = smallConfig();
+  auto rc = smallLearnerConfig();
   rc.runner.checkpoint_every = 1;
   const fs::path dir = freshDir("csv_cut"), saved = freshDir("csv_cut_ckpt");
   FakeActor actor(rc, 10);
   {
-    Learner a(rc, options(dir, 9));
+    Learner a(rc, nodeOptions(dir, 9));
     for (int k = 0; k < 10; ++k) {
       actor.send(a.transport(), 9, k, k);
       ASSERT_TRUE(stepUntilUpdate(a)) << "update " << k;
@@ -387,7 +387,7 @@ TEST(LearnerNode, ResumeCutsMetricsCsvBackToTheCheckpointsUpdate) {
   ASSERT_EQ(readLines(dir / "metrics.csv").size(), 11u);  // header, updates 1..10
   // The learner died after update 10's row but its newest checkpoint is update 6's.
   fs::copy_file(saved / "checkpoint.bin", dir / "checkpoint.bin", fs::copy_options::overwrite_existing);
-  LearnerOptions o = options(dir, 0);
+  LearnerOptions o = nodeOptions(dir, 0);
   o.resume = true;
   Learner b(rc, o);
   ASSERT_EQ(b.version(), 6);
@@ -408,11 +408,11 @@ TEST(LearnerNode, ResumeCutsMetricsCsvBackToTheCheckpointsUpdate) {
 // waiting for the actor's next rollout (the learner used to stall until then: 0.79 of the lossless
 // update rate at 5% datagram loss on the namespace LAN).
 TEST(LearnerNode, ABatchFormsShortOfLostChunksOnceTheirLossIsKnown) {
-  auto rc = smallConfig();  // 8 environments x 4 steps, minibatches of 16
+  auto rc = smallLearnerConfig();  // 8 environments x 4 steps, minibatches of 16
   rc.runner.loss_grace_s = 0.5;
   rc.runner.min_batch_fraction = 0.5;
   const fs::path dir = freshDir("short");
-  Learner learner(rc, options(dir, 21));
+  Learner learner(rc, nodeOptions(dir, 21));
   FakeActor actor(rc, 7);
   actor.chunker = actor::RolloutChunker(1);  // one environment per chunk
   ASSERT_EQ(actor.send(learner.transport(), 21, 0, 0), 8);
@@ -452,11 +452,11 @@ TEST(LearnerNode, ABatchFormsShortOfLostChunksOnceTheirLossIsKnown) {
 // acknowledging heartbeat ends the repeats, and heartbeats of another run or a wild actor id move
 // nothing.
 TEST(LearnerNode, ParametersAreRepeatedUntilEveryLiveActorAcknowledgesThem) {
-  auto rc = smallConfig();
+  auto rc = smallLearnerConfig();
   rc.runner.republish_every_s = 30;  // the periodic republish out of the way
   rc.runner.repeat_unacknowledged_s = 0.05;
   const fs::path dir = freshDir("repeat");
-  Learner learner(rc, options(dir, 23));
+  Learner learner(rc, nodeOptions(dir, 23));
   int broadcasts = 0;
   int64_t latest = -1;
   learner.transport().subscribe<masa::lcmt_policy_params>(transport::kPolicyChannel,
@@ -558,11 +558,11 @@ TEST(ParamsDelivery, RepeatsForALiveActorThatHasNotAcknowledgedAtGrowingInterval
 }
 
 TEST(LearnerNode, AMinibatchSizeThatDoesNotDivideTheBatchIsRefusedByName) {
-  auto rc = smallConfig();
+  auto rc = smallLearnerConfig();
   rc.ppo.minibatch_size = 12;  // 8 x 4 = 32 samples
   const fs::path dir = freshDir("mb");
   try {
-    Learner learner(rc, options(dir, 22));
+    Learner learner(rc, nodeOptions(dir, 22));
     ADD_FAILURE() << "a learner was made";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("ppo.minibatch_size 12 must divide the batch"), std::string::npos) << e.what();

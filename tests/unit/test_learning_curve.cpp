@@ -16,7 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path freshDir(const std::string& name) { return masa::testing::freshTempDir("masa_test_curve_" + name); }
+fs::path freshCurveDir(const std::string& name) { return masa::testing::freshTempDir("masa_test_curve_" + name); }
 
 // A metrics.csv as the learner writes it, with one update in which no episode ended (nan) and an
 // evaluation of the policy mean every other update (nan between).
@@ -51,7 +51,7 @@ bool haveGnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") =
 
 TEST(LearningCurve, RendersAPngFromMetricsWithEveryRewardTerm) {
   if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed (scripts/install_deps.sh installs gnuplot-nox)";
-  const fs::path dir = freshDir("render");
+  const fs::path dir = freshCurveDir("render");
   writeMetrics(dir, 6);
   LearningCurve curve(dir.string(), "a1_beam / masa", {"alive", "velocity"});
   const std::string script = [&] {
@@ -72,7 +72,7 @@ TEST(LearningCurve, RendersAPngFromMetricsWithEveryRewardTerm) {
 // has no point, gnuplot stopped there and no picture came; the off-policy panels draw.
 TEST(LearningCurve, AnOffPolicyRunWithZeroKlAndLearningRateIsDrawnWithItsOwnPanels) {
   if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
-  const fs::path dir = freshDir("off_policy");
+  const fs::path dir = freshCurveDir("off_policy");
   {
     std::ofstream f(dir / "metrics.csv");
     f << "update,env_steps,wall_time_s,fps,return,length,success,term_alive,actor_loss,critic_loss,entropy,"
@@ -118,7 +118,7 @@ TEST(LearningCurve, StepsInMillionsLegendsBelowTheDataAndASuccessAxisOnlyWhereTh
   EXPECT_EQ(without.find("y2"), std::string::npos);
   if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
   for (bool has_success : {true, false}) {
-    const fs::path dir = freshDir(has_success ? "with_success" : "without_success");
+    const fs::path dir = freshCurveDir(has_success ? "with_success" : "without_success");
     writeMetrics(dir, 6);
     LearningCurve curve(dir.string(), "a1_beam / masa", {"alive", "velocity"}, has_success);
     EXPECT_TRUE(curve.renderAndWait()) << "gnuplot log: " << (dir / "learning_curve.log");
@@ -129,7 +129,7 @@ TEST(LearningCurve, StepsInMillionsLegendsBelowTheDataAndASuccessAxisOnlyWhereTh
 
 TEST(LearningCurve, AsyncRenderDoesNotBlockAndIsCollectedByTheDestructor) {
   if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
-  const fs::path dir = freshDir("async");
+  const fs::path dir = freshCurveDir("async");
   writeMetrics(dir, 4);
   {
     LearningCurve curve(dir.string(), "t", {"alive", "velocity"});
@@ -142,7 +142,7 @@ TEST(LearningCurve, AsyncRenderDoesNotBlockAndIsCollectedByTheDestructor) {
 
 TEST(LearningCurve, ABrokenMetricsFileFailsTheRenderInsteadOfWritingAPicture) {
   if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
-  const fs::path dir = freshDir("broken");
+  const fs::path dir = freshCurveDir("broken");
   std::ofstream(dir / "metrics.csv") << "not,the,columns\n1,2,3\n";
   LearningCurve curve(dir.string(), "t", {"alive"});
   EXPECT_FALSE(curve.renderAndWait());
@@ -151,7 +151,7 @@ TEST(LearningCurve, ABrokenMetricsFileFailsTheRenderInsteadOfWritingAPicture) {
 }
 
 TEST(LearningCurve, WithoutGnuplotTheRenderReportsFailureAndTrainingGoesOn) {
-  const fs::path dir = freshDir("missing");
+  const fs::path dir = freshCurveDir("missing");
   writeMetrics(dir, 3);
   const char* old_path = std::getenv("PATH");
   const std::string saved = old_path ? old_path : "";
@@ -178,7 +178,7 @@ TEST(LearningCurve, NamesCannotRunACommandOrAMacroInTheScript) {
   EXPECT_EQ(gnuplotQuoted("a1_beam / masa, seed 7 (x1.5) [10%]"), "\"a1_beam / masa, seed 7 (x1.5) [10%]\"")
       << "ordinary titles pass unchanged";
   if (!haveGnuplot()) GTEST_SKIP() << "gnuplot is not installed";
-  const fs::path dir = freshDir("injection");
+  const fs::path dir = freshCurveDir("injection");
   writeMetrics(dir, 4);
   LearningCurve curve(dir.string(), "a1_beam / masa", {evil, "alive"}, false);
   curve.renderAndWait();

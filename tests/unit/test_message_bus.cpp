@@ -21,7 +21,7 @@ namespace {
 using testing::encode;
 using testing::samplePolicy;
 
-lcmt_actor_heartbeat sampleHeartbeat() {
+lcmt_actor_heartbeat busHeartbeat() {
   lcmt_actor_heartbeat h{};
   h.run_id = 42;
   h.actor_id = 3;
@@ -55,12 +55,12 @@ std::vector<std::string> runScript(MessageBus& bus) {
   // Changed after publishing: what arrives is what was published.
   policy.version = 18;
   policy.params[0] = 7.0f;
-  const std::vector<uint8_t> heartbeat = encode(sampleHeartbeat()), later_policy = encode(policy);
+  const std::vector<uint8_t> heartbeat = encode(busHeartbeat()), later_policy = encode(policy);
   EXPECT_TRUE(bus.publishRaw(kHeartbeatChannel, heartbeat.data(), static_cast<int>(heartbeat.size())));
   // Three bytes short: the raw subscriber gets it, the typed one's guard refuses it.
   EXPECT_TRUE(bus.publishRaw(kPolicyChannel, later_policy.data(), static_cast<int>(later_policy.size()) - 3));
   // A heartbeat on the policy channel: of the wrong type for the typed subscriber.
-  EXPECT_TRUE(bus.publish(kPolicyChannel, sampleHeartbeat()));
+  EXPECT_TRUE(bus.publish(kPolicyChannel, busHeartbeat()));
   seen.push_back("drained " + std::to_string(bus.drain()));
 
   bus.unsubscribe(raw);
@@ -78,7 +78,7 @@ TEST(MessageBus, LcmAndTheInProcessBusDeliverTheSameMessagesToTheSameSubscribers
   EXPECT_EQ(by_local, by_lcm);
 
   // And what they deliver is the script's, not merely alike.
-  const std::vector<uint8_t> first = encode(samplePolicy()), heartbeat = encode(sampleHeartbeat());
+  const std::vector<uint8_t> first = encode(samplePolicy()), heartbeat = encode(busHeartbeat());
   ASSERT_EQ(by_local.size(), 8u);
   EXPECT_EQ(by_local[0], "policy v17 of 40, first -0.200000");
   EXPECT_EQ(by_local[1], bytesSeen(first.data(), static_cast<int>(first.size())));
@@ -96,7 +96,7 @@ TEST(MessageBus, LcmAndTheInProcessBusDeliverTheSameMessagesToTheSameSubscribers
 // heartbeat whose host name holds a NUL, which LCM's C-string encoding cannot carry (Transport
 // refuses to publish it), arrives whole; a raw subscriber, which needs the bytes, gets nothing.
 TEST(MessageBus, TheInProcessBusHandsTypedMessagesOverWithoutEncodingThem) {
-  lcmt_actor_heartbeat h = sampleHeartbeat();
+  lcmt_actor_heartbeat h = busHeartbeat();
   h.hostname = std::string("node\0a", 6);
   Transport lcm("memq://");
   EXPECT_FALSE(lcm.publish(kHeartbeatChannel, h));

@@ -38,7 +38,7 @@ namespace fs = std::filesystem;
 using testing::encode;
 using testing::samplePolicy;
 
-fs::path freshDir(const std::string& name) {
+fs::path freshSignDir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("masa_test_sign_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   fs::create_directories(d);
@@ -53,7 +53,7 @@ struct SignedRun {
   std::shared_ptr<MessageSigner> learner;
   std::vector<std::shared_ptr<MessageSigner>> actors;
 
-  explicit SignedRun(int num_actors, const std::string& name = "run") : dir(freshDir(name)) {
+  explicit SignedRun(int num_actors, const std::string& name = "run") : dir(freshSignDir(name)) {
     std::vector<std::pair<SenderId, fs::path>> keys;
     keys.push_back({{Role::kLearner, 0}, dir / "learner0"});
     for (int a = 0; a < num_actors; ++a) keys.push_back({{Role::kActor, static_cast<uint32_t>(a)}, dir / ("actor" + std::to_string(a))});
@@ -332,22 +332,22 @@ TEST(MessageSignTransport, ARefusedMessageLeavesNoTraceInTheWindow) {
 // ---------------------------------------------------------------------------------------------
 // The actors: parameters signed by an actor's key.
 
-constexpr int64_t kRunId = 4242;
+constexpr int64_t kSignedRunId = 4242;
 
-config::RunConfig smallConfig() {
+config::RunConfig smallSignedRunConfig() {
   return config::loadRunConfig(config::defaultConfigsDir(),
                                {"task=trifinger_lift", "model.policy_hidden=[16]", "model.critic_hidden=[16]",
                                 "ppo.num_envs=8", "ppo.horizon=4", "ppo.minibatch_size=16", "ppo.mini_epochs=1"});
 }
 
 // Valid parameters for `rc` (the policy prefix of an initialized model).
-masa::lcmt_policy_params paramsFor(const config::RunConfig& rc, int64_t version) {
+masa::lcmt_policy_params signParamsFor(const config::RunConfig& rc, int64_t version) {
   const auto spec = sym::SymmetrySpec::load(rc.spec_path);
   model::ActorCritic<float> model(spec, rc.model);
   Rng rng(5);
   model.initialize(rng);
   masa::lcmt_policy_params p;
-  p.run_id = kRunId;
+  p.run_id = kSignedRunId;
   p.utime = 0;
   p.version = version;
   p.method = model::methodName(rc.method);
@@ -361,7 +361,7 @@ masa::lcmt_policy_params paramsFor(const config::RunConfig& rc, int64_t version)
 }
 
 TEST(MessageSignActors, AParameterMessageSignedByAnActorsKeyIsRefusedByEveryActorAndCounted) {
-  const auto rc = smallConfig();
+  const auto rc = smallSignedRunConfig();
   SignedRun run(2, "actors");
   // Each actor on its own in-process bus, with its own key; the same bytes reach each of them.
   std::vector<std::unique_ptr<Transport>> buses;
@@ -371,12 +371,12 @@ TEST(MessageSignActors, AParameterMessageSignedByAnActorsKeyIsRefusedByEveryActo
     actor::ActorOptions o;
     o.actor_id = a;
     o.num_envs = 1;
-    o.run_id = kRunId;
+    o.run_id = kSignedRunId;
     o.threads = 1;
     o.await_params_s = 0;
     actors.push_back(std::make_unique<actor::Actor>(rc, o, buses.back().get()));
   }
-  const std::vector<uint8_t> params = encode(paramsFor(rc, 1));
+  const std::vector<uint8_t> params = encode(signParamsFor(rc, 1));
   // Actor 1's key, compromised: parameters as the learner would send them, in every field.
   const std::vector<uint8_t> forged = signedBytes(*run.actors[1], kPolicyChannel, params);
   for (int a = 0; a < 2; ++a) {
@@ -402,14 +402,14 @@ learner::LearnerOptions learnerOptions(const fs::path& dir, const SignedRun& run
   learner::LearnerOptions o;
   o.url = "memq://";
   o.run_dir = dir.string();
-  o.run_id = kRunId;
+  o.run_id = kSignedRunId;
   o.verbose = false;
   o.signed_mode = run.as(run.learner);
   return o;
 }
 
 // A whole batch (8 environments x 4 steps) of actor `actor_id`'s rollout `seq`, encoded.
-std::vector<std::vector<uint8_t>> batchOf(const config::RunConfig& rc, int actor_id, int64_t seq) {
+std::vector<std::vector<uint8_t>> signedBatchOf(const config::RunConfig& rc, int actor_id, int64_t seq) {
   const auto spec = sym::SymmetrySpec::load(rc.spec_path);
   const int E = rc.ppo.num_envs, T = rc.ppo.horizon, od = spec.obsDim(), ad = spec.actDim();
   rollout::Rollout r;
@@ -425,30 +425,30 @@ std::vector<std::vector<uint8_t>> batchOf(const config::RunConfig& rc, int actor
   for (float& x : r.log_prob) x = -1.0f;
   actor::RolloutChunker chunker(2000);  // several chunks
   std::vector<std::vector<uint8_t>> out;
-  for (const auto& c : chunker.split(r, {kRunId, actor_id, seq, 0})) out.push_back(encode(c));
+  for (const auto& c : chunker.split(r, {kSignedRunId, actor_id, seq, 0})) out.push_back(encode(c));
   return out;
 }
 
-bool stepUntilUpdate(learner::Learner& l, int max_steps = 100) {
+bool stepUntilSignedUpdate(learner::Learner& l, int max_steps = 100) {
   bool updated = false;
   for (int i = 0; i < max_steps && !updated; ++i) updated = l.step(0);
   return updated;
 }
 
 TEST(MessageSignLearner, ARolloutChunkSignedByActorOneClaimingActorZeroIsRefusedAndCounted) {
-  const auto rc = smallConfig();
+  const auto rc = smallSignedRunConfig();
   SignedRun run(2, "claims");
   const fs::path dir = run.dir / "learner";
   learner::Learner learner(rc, learnerOptions(dir, run));
   auto& bus = dynamic_cast<Transport&>(learner.transport());  // bytes on the wire, as a forger sends them
-  const auto chunks = batchOf(rc, 0, 0);
+  const auto chunks = signedBatchOf(rc, 0, 0);
   ASSERT_GT(chunks.size(), 1u);
   // Actor 1's key on a whole batch that names actor 0.
   for (const auto& c : chunks) {
     const auto b = signedBytes(*run.actors[1], kRolloutChannel, c);
     ASSERT_TRUE(bus.publishWire(kRolloutChannel, b.data(), static_cast<int>(b.size())));
   }
-  EXPECT_FALSE(stepUntilUpdate(learner, 30));
+  EXPECT_FALSE(stepUntilSignedUpdate(learner, 30));
   EXPECT_EQ(learner.version(), 0);
   EXPECT_EQ(learner.dropStats()[learner::DropReason::kClaimsAnotherActor], static_cast<int64_t>(chunks.size()));
   EXPECT_EQ(learner.dropStats()[learner::DropReason::kAccepted], 0);
@@ -457,22 +457,22 @@ TEST(MessageSignLearner, ARolloutChunkSignedByActorOneClaimingActorZeroIsRefused
     const auto b = signedBytes(*run.actors[0], kRolloutChannel, c);
     ASSERT_TRUE(bus.publishWire(kRolloutChannel, b.data(), static_cast<int>(b.size())));
   }
-  ASSERT_TRUE(stepUntilUpdate(learner)) << bus.rejectSummary();
+  ASSERT_TRUE(stepUntilSignedUpdate(learner)) << bus.rejectSummary();
   EXPECT_EQ(learner.version(), 1);
   EXPECT_EQ(learner.dropStats()[learner::DropReason::kDuplicate], 0);
   EXPECT_EQ(learner.dropStats()[learner::DropReason::kAccepted], static_cast<int64_t>(chunks.size()));
 }
 
 TEST(MessageSignLearner, AReplayedChunkIsRefusedAsReplayedAndANonActorsChunkIsNotPermitted) {
-  const auto rc = smallConfig();
+  const auto rc = smallSignedRunConfig();
   SignedRun run(1, "learner_replay");
   learner::Learner learner(rc, learnerOptions(run.dir / "learner", run));
   auto& bus = dynamic_cast<Transport&>(learner.transport());  // bytes on the wire, as a forger sends them
-  const auto chunks = batchOf(rc, 0, 0);
+  const auto chunks = signedBatchOf(rc, 0, 0);
   std::vector<std::vector<uint8_t>> sent;
   for (const auto& c : chunks) sent.push_back(signedBytes(*run.actors[0], kRolloutChannel, c));
   for (const auto& b : sent) bus.publishWire(kRolloutChannel, b.data(), static_cast<int>(b.size()));
-  ASSERT_TRUE(stepUntilUpdate(learner)) << bus.rejectSummary();
+  ASSERT_TRUE(stepUntilSignedUpdate(learner)) << bus.rejectSummary();
   for (const auto& b : sent) bus.publishWire(kRolloutChannel, b.data(), static_cast<int>(b.size()));
   // The learner's own key on a chunk: the roster lets it publish parameters, not rollouts.
   const auto by_learner = signedBytes(*run.learner, kRolloutChannel, chunks[0]);

@@ -70,7 +70,7 @@ Mat<float> uniform(int rows, int cols, Rng& rng) {
   return m;
 }
 
-Steps train(int width, int batch, int steps) {
+Steps trainAtWidth(int width, int batch, int steps) {
   const MlpShape shape{23, {150, 60}, 7, Activation::kElu, Activation::kIdentity};
   ParameterSet<float> params;
   Mlp<float> mlp(params, "net", shape);
@@ -102,9 +102,9 @@ TEST(MlpChunkWidth, EveryWidthAndTheTuningItselfGiveBitIdenticalResults) {
     omp_set_num_threads(threads);
     for (int batch : {777, 2100}) {  // blocks split unevenly over the threads; a partial last block
       const int steps = 3 * ChunkTuner::kStepsPerCandidate + 2;
-      const Steps reference = train(128, batch, steps);
+      const Steps reference = trainAtWidth(128, batch, steps);
       for (int width : {0, 256, 384, 512}) {
-        const Steps other = train(width, batch, steps);
+        const Steps other = trainAtWidth(width, batch, steps);
         for (int s = 0; s < steps; ++s) {
           const std::string where = "width " + std::to_string(width) + " (0: tuned), batch " + std::to_string(batch) +
                                     ", threads " + std::to_string(threads) + ", step " + std::to_string(s);

@@ -9,9 +9,9 @@ namespace {
 
 // (trans_a, trans_b, m, n, k): small, single-column (GEMV path), and large enough to be blocked
 // and split over threads.
-using Case = std::tuple<bool, bool, int, int, int>;
+using GemmCase = std::tuple<bool, bool, int, int, int>;
 
-class GemmWorkspaceProduct : public ::testing::TestWithParam<Case> {};
+class GemmWorkspaceProduct : public ::testing::TestWithParam<GemmCase> {};
 
 TEST_P(GemmWorkspaceProduct, MatchesEigenForStridedOperandsAndAccumulates) {
   const auto [ta, tb, m, n, k] = GetParam();
@@ -41,10 +41,10 @@ TEST_P(GemmWorkspaceProduct, MatchesEigenForStridedOperandsAndAccumulates) {
 
 INSTANTIATE_TEST_SUITE_P(
     Shapes, GemmWorkspaceProduct,
-    ::testing::Values(Case{false, false, 5, 3, 4}, Case{false, true, 5, 3, 4}, Case{true, false, 5, 3, 4},
-                      Case{true, true, 5, 3, 4}, Case{false, false, 37, 1, 29}, Case{true, false, 37, 1, 29},
-                      Case{false, true, 37, 1, 29}, Case{false, false, 200, 301, 150}, Case{false, true, 100, 74, 900},
-                      Case{true, false, 74, 530, 400}, Case{true, true, 63, 257, 129}));
+    ::testing::Values(GemmCase{false, false, 5, 3, 4}, GemmCase{false, true, 5, 3, 4}, GemmCase{true, false, 5, 3, 4},
+                      GemmCase{true, true, 5, 3, 4}, GemmCase{false, false, 37, 1, 29}, GemmCase{true, false, 37, 1, 29},
+                      GemmCase{false, true, 37, 1, 29}, GemmCase{false, false, 200, 301, 150}, GemmCase{false, true, 100, 74, 900},
+                      GemmCase{true, false, 74, 530, 400}, GemmCase{true, true, 63, 257, 129}));
 
 TEST(GemmWorkspace, SmallerProductsReuseTheBuffersOfTheLargestPlan) {
   GemmWorkspace<float> ws;

@@ -50,10 +50,10 @@ double worstError(nn::ParameterSet<double>& params, int begin, int end, Loss los
 }
 
 const model::Method kMethods[] = {model::Method::kSa, model::Method::kMasa};
-const char* const kSpecs[] = {test::kMirrorSpec, test::kC3Spec};
+const char* const kGradientSpecs[] = {test::kMirrorSpec, test::kC3Spec};
 
 TEST(OfflineGradient, IqlValueLossOverTheCritic) {
-  for (const char* yaml : kSpecs)
+  for (const char* yaml : kGradientSpecs)
     for (auto method : kMethods) {
       Fixture f(yaml, method);
       IqlTrainer<double> iql(f.model, f.q, f.q_target, test::smallOfflineConfig(Algo::kIql, 10));
@@ -68,7 +68,7 @@ TEST(OfflineGradient, IqlValueLossOverTheCritic) {
 }
 
 TEST(OfflineGradient, IqlActorLossOverThePolicy) {
-  for (const char* yaml : kSpecs)
+  for (const char* yaml : kGradientSpecs)
     for (auto method : kMethods) {
       Fixture f(yaml, method);
       IqlTrainer<double> iql(f.model, f.q, f.q_target, test::smallOfflineConfig(Algo::kIql, 10));
@@ -84,7 +84,7 @@ TEST(OfflineGradient, IqlActorLossOverThePolicy) {
 }
 
 TEST(OfflineGradient, IqlTdLossOverBothQs) {
-  for (const char* yaml : kSpecs)
+  for (const char* yaml : kGradientSpecs)
     for (auto method : kMethods) {
       Fixture f(yaml, method);
       IqlTrainer<double> iql(f.model, f.q, f.q_target, test::smallOfflineConfig(Algo::kIql, 10), 0.7);
@@ -96,7 +96,7 @@ TEST(OfflineGradient, IqlTdLossOverBothQs) {
 }
 
 TEST(OfflineGradient, BcLikelihoodAndMseOverThePolicy) {
-  for (const char* yaml : kSpecs)
+  for (const char* yaml : kGradientSpecs)
     for (auto method : kMethods)
       for (BcLoss kind : {BcLoss::kGaussian, BcLoss::kMse}) {
         Fixture f(yaml, method);

@@ -90,7 +90,7 @@ action:
     - {name: pad, kind: invariant}
 )";
 
-constexpr int kHorizon = 8;
+constexpr int kOfflineHorizon = 8;
 constexpr double kStepSize = 0.25;
 
 struct PointMdp {
@@ -112,7 +112,7 @@ dataset::TransitionDataset mixedPointData(int episodes, Rng& rng) {
   d.task = "point";
   d.obs_dim = 4;
   d.act_dim = 4;
-  const int n = episodes * kHorizon;
+  const int n = episodes * kOfflineHorizon;
   d.obs.resize(4, n);
   d.next_obs.resize(4, n);
   d.actions.resize(4, n);
@@ -123,9 +123,9 @@ dataset::TransitionDataset mixedPointData(int episodes, Rng& rng) {
   for (int e = 0; e < episodes; ++e) {
     const bool expert = e % 2 == 0;
     Eigen::Vector2d p = PointMdp::start(rng);
-    dataset::EpisodeInfo info{e, expert ? 0 : 1, static_cast<int64_t>(e) * kHorizon, kHorizon, 0.0, -1};
-    for (int t = 0; t < kHorizon; ++t) {
-      const int k = e * kHorizon + t;
+    dataset::EpisodeInfo info{e, expert ? 0 : 1, static_cast<int64_t>(e) * kOfflineHorizon, kOfflineHorizon, 0.0, -1};
+    for (int t = 0; t < kOfflineHorizon; ++t) {
+      const int k = e * kOfflineHorizon + t;
       Vec<float> a(4);
       if (expert) {
         const Eigen::Vector2d v = (-p / kStepSize).cwiseMax(-1).cwiseMin(1);
@@ -140,7 +140,7 @@ dataset::TransitionDataset mixedPointData(int episodes, Rng& rng) {
       d.rewards(k) = static_cast<float>(PointMdp::reward(p));
       info.ret += d.rewards(k);
       d.terminals.push_back(0);
-      d.timeouts.push_back(t == kHorizon - 1);
+      d.timeouts.push_back(t == kOfflineHorizon - 1);
     }
     d.episodes.push_back(info);
   }
@@ -155,7 +155,7 @@ double pointReturn(model::ActorCritic<float>& m) {
   const int episodes = 200;
   for (int e = 0; e < episodes; ++e) {
     Eigen::Vector2d p = PointMdp::start(rng);
-    for (int t = 0; t < kHorizon; ++t) {
+    for (int t = 0; t < kOfflineHorizon; ++t) {
       const Vec<float> a = m.actMean(PointMdp::observe(p));
       p = PointMdp::step(p, a);
       total += PointMdp::reward(p);

@@ -62,11 +62,11 @@ struct Trained {
   }
 };
 
-const char* const kSpecs[] = {test::kMirrorSpec, test::kC3Spec, test::kC4Spec};
+const char* const kOfflineSpecs[] = {test::kMirrorSpec, test::kC3Spec, test::kC4Spec};
 
 TEST(OfflineSymmetry, MasaBcAndIqlPoliciesEquivariantValueInvariantAndQSymmetricTo1e5) {
   for (Algo algo : {Algo::kBc, Algo::kIql})
-    for (const char* yaml : kSpecs) {
+    for (const char* yaml : kOfflineSpecs) {
       const auto spec = test::spec(yaml, "spec");
       Rng rng(21);
       Trained t(spec, model::Method::kMasa, algo, rng);

@@ -23,14 +23,14 @@ fs::path tempFile(const std::string& name) {
   return fs::temp_directory_path() / ("masa_test_policy_" + name + "_" + std::to_string(::getpid()));
 }
 
-config::RunConfig smallConfig(const std::string& task, const std::string& method) {
+config::RunConfig smallPolicyConfig(const std::string& task, const std::string& method) {
   return config::loadRunConfig(config::defaultConfigsDir(),
                                {"task=" + task, "method=" + method, "model.policy_hidden=[16]",
                                 "model.critic_hidden=[16]", "env.max_episode_steps=30"});
 }
 
 TEST(PolicyFile, RoundTripsConfigSpecNetworksAndNormalizerBitForBit) {
-  const config::RunConfig rc = smallConfig("ant_acrobatic", "masa");
+  const config::RunConfig rc = smallPolicyConfig("ant_acrobatic", "masa");
   const auto spec = sym::SymmetrySpec::load(rc.spec_path);
   model::ActorCritic<float> m(spec, rc.model);
   Rng rng(3);
@@ -55,7 +55,7 @@ TEST(PolicyFile, RoundTripsConfigSpecNetworksAndNormalizerBitForBit) {
 }
 
 TEST(PolicyFile, ATruncatedOrForeignFileIsRefusedWithItsName) {
-  const config::RunConfig rc = smallConfig("a1_beam", "sa");
+  const config::RunConfig rc = smallPolicyConfig("a1_beam", "sa");
   const auto spec = sym::SymmetrySpec::load(rc.spec_path);
   model::ActorCritic<float> m(spec, rc.model);
   Rng rng(3);
@@ -80,7 +80,7 @@ TEST(PolicyFile, AMasaPolicyWhoseSpecWasSwappedFailsTheEquivarianceCheckOnLoad) 
   // build the model under a1_beam's spec, then perturb its weights asymmetrically is impossible
   // (MASA is equivariant by construction), so break the normalizer instead: statistics that are
   // not orbit-symmetric make the whole pipeline non-equivariant.
-  const config::RunConfig rc = smallConfig("a1_beam", "masa");
+  const config::RunConfig rc = smallPolicyConfig("a1_beam", "masa");
   const auto spec = sym::SymmetrySpec::load(rc.spec_path);
   LoadedPolicy p;
   p.config = rc;
@@ -112,7 +112,7 @@ TEST(TaskFactory, ANaNOrInfiniteEnvSettingIsRefusedNamingTheKey) {
 }
 
 TEST(PolicyEvaluator, EpisodesDependOnTheirSeedsOnlyNotOnTheBatchOrThreads) {
-  const config::RunConfig rc = smallConfig("a1_beam", "masa");
+  const config::RunConfig rc = smallPolicyConfig("a1_beam", "masa");
   const auto spec = sym::SymmetrySpec::load(rc.spec_path);
   model::ActorCritic<float> m(spec, rc.model);
   Rng rng(9);

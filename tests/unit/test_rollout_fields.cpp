@@ -12,18 +12,18 @@
 namespace masa::rollout {
 namespace {
 
-constexpr int kT = 3, kObs = 2, kAct = 2;
+constexpr int kRolloutT = 3, kObs = 2, kAct = 2;
 
 // A rollout of `envs` environments whose every value says where it is: value(field, t, e, k).
 Rollout filled(int envs, int terms) {
   std::vector<std::string> names;
   for (int k = 0; k < terms; ++k) names.push_back("term" + std::to_string(k));
   Rollout r;
-  r.allocate(envs, kT, kObs, kAct, names);
-  for (int t = 0; t <= kT; ++t)
+  r.allocate(envs, kRolloutT, kObs, kAct, names);
+  for (int t = 0; t <= kRolloutT; ++t)
     for (int e = 0; e < envs; ++e)
       for (int k = 0; k < kObs; ++k) r.obsAt(t, e)[k] = 1000.0f * t + 10.0f * e + k;
-  for (int t = 0; t < kT; ++t)
+  for (int t = 0; t < kRolloutT; ++t)
     for (int e = 0; e < envs; ++e) {
       for (int k = 0; k < kAct; ++k) {
         r.actionAt(t, e)[k] = 2000.0f + 1000.0f * t + 10.0f * e + k;
@@ -51,10 +51,10 @@ Rollout filled(int envs, int terms) {
 TEST(RolloutFields, EnvironmentsLandAtTheirMappedColumnsWithTheirEventsRenumbered) {
   const Rollout src = filled(5, 2);
   Rollout dst;
-  dst.allocate(3, kT, kObs, kAct, src.term_names);
+  dst.allocate(3, kRolloutT, kObs, kAct, src.term_names);
   std::fill(dst.obs.begin(), dst.obs.end(), -1.0f);
   const std::vector<int> to = {-1, 2, 0, 1, -1};  // source env 1 -> 2, 2 -> 0, 3 -> 1
-  const EnvCopy copy{.horizon = kT, .obs_dim = kObs, .act_dim = kAct, .src_envs = 5, .dst_envs = 3, .dst_env = to,
+  const EnvCopy copy{.horizon = kRolloutT, .obs_dim = kObs, .act_dim = kAct, .src_envs = 5, .dst_envs = 3, .dst_env = to,
                      .src_terms = 2, .dst_terms = 2};
   copyEnvironmentSteps(src, dst, copy);
   appendEnvironmentEvents(src, dst, copy);
@@ -62,9 +62,9 @@ TEST(RolloutFields, EnvironmentsLandAtTheirMappedColumnsWithTheirEventsRenumbere
   for (int e = 0; e < 5; ++e) {
     const int d = to[e];
     if (d < 0) continue;
-    for (int t = 0; t <= kT; ++t)
+    for (int t = 0; t <= kRolloutT; ++t)
       for (int k = 0; k < kObs; ++k) EXPECT_EQ(dst.obsAt(t, d)[k], src.obsAt(t, e)[k]) << t << " " << e;
-    for (int t = 0; t < kT; ++t) {
+    for (int t = 0; t < kRolloutT; ++t) {
       for (int k = 0; k < kAct; ++k) {
         EXPECT_EQ(dst.actionAt(t, d)[k], src.actionAt(t, e)[k]);
         EXPECT_EQ(dst.meanAt(t, d)[k], src.meanAt(t, e)[k]);
@@ -91,9 +91,9 @@ TEST(RolloutFields, EnvironmentsLandAtTheirMappedColumnsWithTheirEventsRenumbere
 TEST(RolloutFields, EpisodeNumberingBasesAndOtherTermsAreHonoured) {
   const Rollout src = filled(5, 3);
   Rollout dst;
-  dst.allocate(2, kT, kObs, kAct, {"a", "b"});
+  dst.allocate(2, kRolloutT, kObs, kAct, {"a", "b"});
   const std::vector<int> to = {-1, -1, -1, 0, 1};
-  const EnvCopy copy{.horizon = kT, .obs_dim = kObs, .act_dim = kAct, .src_envs = 5, .dst_envs = 2, .dst_env = to,
+  const EnvCopy copy{.horizon = kRolloutT, .obs_dim = kObs, .act_dim = kAct, .src_envs = 5, .dst_envs = 2, .dst_env = to,
                      .src_episode_base = 0, .dst_episode_base = 10, .src_terms = 3, .dst_terms = 2};
   appendEnvironmentEvents(src, dst, copy);
   EXPECT_EQ(dst.episode_env, (std::vector<int32_t>{11, 10}));  // source 4 -> 1, 3 -> 0, from base 10
@@ -102,9 +102,9 @@ TEST(RolloutFields, EpisodeNumberingBasesAndOtherTermsAreHonoured) {
 
   // And back: a source that numbers from 10.
   Rollout back;
-  back.allocate(5, kT, kObs, kAct, {"a", "b"});
+  back.allocate(5, kRolloutT, kObs, kAct, {"a", "b"});
   const std::vector<int> from_chunk = {3, 4};
-  const EnvCopy copy_back{.horizon = kT, .obs_dim = kObs, .act_dim = kAct, .src_envs = 2, .dst_envs = 5,
+  const EnvCopy copy_back{.horizon = kRolloutT, .obs_dim = kObs, .act_dim = kAct, .src_envs = 2, .dst_envs = 5,
                           .dst_env = from_chunk, .src_episode_base = 10, .src_terms = 2, .dst_terms = 2};
   appendEnvironmentEvents(dst, back, copy_back);
   EXPECT_EQ(back.episode_env, (std::vector<int32_t>{4, 3}));
@@ -112,7 +112,7 @@ TEST(RolloutFields, EpisodeNumberingBasesAndOtherTermsAreHonoured) {
 
 TEST(RolloutFields, SortFinalsPutsTruncationsInStepOrderWithTheirObservations) {
   Rollout r;
-  r.allocate(2, kT, kObs, kAct);
+  r.allocate(2, kRolloutT, kObs, kAct);
   r.final_index = {5, 1, 3};
   r.final_obs = {50, 51, 10, 11, 30, 31};
   std::vector<std::pair<int32_t, int32_t>> order;
@@ -124,12 +124,12 @@ TEST(RolloutFields, SortFinalsPutsTruncationsInStepOrderWithTheirObservations) {
 
 TEST(RolloutFields, ResizeAndClearWalkEveryArray) {
   Rollout r = filled(4, 1);
-  resizeSteps(r, kT, 2, kObs, kAct);
-  EXPECT_EQ(r.obs.size(), static_cast<std::size_t>((kT + 1) * 2 * kObs));
-  EXPECT_EQ(r.actions.size(), static_cast<std::size_t>(kT * 2 * kAct));
+  resizeSteps(r, kRolloutT, 2, kObs, kAct);
+  EXPECT_EQ(r.obs.size(), static_cast<std::size_t>((kRolloutT + 1) * 2 * kObs));
+  EXPECT_EQ(r.actions.size(), static_cast<std::size_t>(kRolloutT * 2 * kAct));
   EXPECT_EQ(r.mean.size(), r.actions.size());
   for (const std::size_t n : {r.log_prob.size(), r.reward.size(), r.terminated.size(), r.truncated.size()})
-    EXPECT_EQ(n, static_cast<std::size_t>(kT * 2));
+    EXPECT_EQ(n, static_cast<std::size_t>(kRolloutT * 2));
   clearEvents(r);
   EXPECT_EQ(r.numFinal(), 0);
   EXPECT_TRUE(r.final_obs.empty());

@@ -15,7 +15,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path freshDir(const std::string& name) { return masa::testing::freshTempDir("masa_test_run_key_" + name); }
+fs::path freshKeyDir(const std::string& name) { return masa::testing::freshTempDir("masa_test_run_key_" + name); }
 
 std::string errorOf(const std::string& path) {
   try {
@@ -27,7 +27,7 @@ std::string errorOf(const std::string& path) {
 }
 
 TEST(RunKey, IsMadeOnceWithModeSixHundredAndReadBackTheSame) {
-  const fs::path dir = freshDir("make");
+  const fs::path dir = freshKeyDir("make");
   const std::string path = (dir / "run.key").string();
   const RunKey made = readOrCreateRunKey(path);
   struct stat st {};
@@ -44,7 +44,7 @@ TEST(RunKey, IsMadeOnceWithModeSixHundredAndReadBackTheSame) {
 }
 
 TEST(RunKey, AMalformedOrMissingFileIsRefusedWithItsPath) {
-  const fs::path dir = freshDir("bad");
+  const fs::path dir = freshKeyDir("bad");
   const std::string short_key = (dir / "short.key").string(), not_hex = (dir / "not_hex.key").string();
   std::ofstream(short_key) << "abcd\n";
   std::ofstream(not_hex) << std::string(63, 'a') << "g\n";
@@ -56,7 +56,7 @@ TEST(RunKey, AMalformedOrMissingFileIsRefusedWithItsPath) {
 }
 
 TEST(RunKey, UpperCaseHexReadsAsTheSameKey) {
-  const fs::path dir = freshDir("case");
+  const fs::path dir = freshKeyDir("case");
   const std::string lower = (dir / "lower.key").string(), upper = (dir / "upper.key").string();
   std::ofstream(lower) << std::string(32, 'a') << std::string(32, '7') << "\n";
   std::ofstream(upper) << std::string(32, 'A') << std::string(32, '7');
@@ -71,7 +71,7 @@ TEST(RunKey, UpperCaseHexReadsAsTheSameKey) {
 
 // docs/inputs.md gap 9: a run key others may read was only warned about; it is refused now.
 TEST(RunKey, AKeyOthersMayReadIsRefusedSayingHowToFixIt) {
-  const fs::path dir = freshDir("mode");
+  const fs::path dir = freshKeyDir("mode");
   const std::string path = (dir / "run.key").string();
   readOrCreateRunKey(path);
   fs::permissions(path, fs::perms::others_read, fs::perm_options::add);

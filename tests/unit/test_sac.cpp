@@ -180,7 +180,7 @@ TEST(SacSquashedGaussian, ReparameterizedGradientsMatchFiniteDifferences) {
 
 // ---------------------------------------------------------------- symmetry of the networks
 
-const char* const kSpecs[] = {test::kMirrorSpec, test::kC3Spec, test::kC4Spec};
+const char* const kSacSpecs[] = {test::kMirrorSpec, test::kC3Spec, test::kC4Spec};
 
 SacPolicyShape smallShape(Method method) {
   SacPolicyShape s;
@@ -238,7 +238,7 @@ PolicySymmetry policySymmetry(const sym::SymmetrySpec& spec, Method method) {
 }
 
 TEST(SacSymmetry, MasaPolicyIsEquivariantInMeanLogStdActionAndLogProbAndSaIsNot) {
-  for (const char* yaml : kSpecs) {
+  for (const char* yaml : kSacSpecs) {
     const auto spec = test::spec(yaml, "spec");
     const PolicySymmetry masa = policySymmetry(spec, Method::kMasa);
     EXPECT_LT(masa.mean, 1e-5) << spec.name();
@@ -270,7 +270,7 @@ double twinQSymmetry(const sym::SymmetrySpec& spec, Method method) {
 }
 
 TEST(SacSymmetry, MasaTwinQIsInvariantUnderTheJointTransformAndSaAndMaAreNot) {
-  for (const char* yaml : kSpecs) {
+  for (const char* yaml : kSacSpecs) {
     const auto spec = test::spec(yaml, "spec");
     EXPECT_LT(twinQSymmetry(spec, Method::kMasa), 1e-5) << spec.name();
     EXPECT_GT(twinQSymmetry(spec, Method::kSa), 1e-4) << spec.name();

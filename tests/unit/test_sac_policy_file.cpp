@@ -36,11 +36,11 @@ namespace {
 namespace fs = std::filesystem;
 using model::Method;
 
-fs::path tempFile(const std::string& name) {
+fs::path sacTempFile(const std::string& name) {
   return fs::temp_directory_path() / ("masa_test_sac_policy_" + name + "_" + std::to_string(::getpid()));
 }
 
-std::string slurp(const fs::path& p) {
+std::string policyFileBytes(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
   std::ostringstream ss;
   ss << f.rdbuf();
@@ -93,7 +93,7 @@ struct SacSetup {
     }
   }
   policy::LoadedPolicy saveAndLoad(const std::string& name) {
-    const fs::path f = tempFile(name);
+    const fs::path f = sacTempFile(name);
     saveSacPolicyFile(f.string(), rc, sc, policy, spec);
     policy::LoadedPolicy p = policy::loadPolicyFile(f.string());
     fs::remove(f);
@@ -182,17 +182,17 @@ uint32_t formatVersion(const std::string& sealed) {
 
 TEST(SacPolicyFile, SquashedFilesAreFormat2AndPpoFilesStayFormat1) {
   SacSetup s("a1_beam", "sa", true, 14);
-  const fs::path sac = tempFile("format_sac"), ppo = tempFile("format_ppo");
+  const fs::path sac = sacTempFile("format_sac"), ppo = sacTempFile("format_ppo");
   saveSacPolicyFile(sac.string(), s.rc, s.sc, s.policy, s.spec);
-  EXPECT_EQ(formatVersion(slurp(sac)), 2u);
+  EXPECT_EQ(formatVersion(policyFileBytes(sac)), 2u);
   const config::RunConfig rc = config::loadRunConfig(config::defaultConfigsDir(),
                                                      {"task=a1_beam", "model.policy_hidden=[8]", "model.critic_hidden=[8]"});
   model::ActorCritic<float> m(s.spec, rc.model);
   Rng rng(1);
   m.initialize(rng);
   policy::savePolicyFile(ppo.string(), rc, m);
-  EXPECT_EQ(formatVersion(slurp(ppo)), 1u);
-  EXPECT_EQ(formatVersion(slurp(fs::path(MASA_SOURCE_DIR) / "tasks/a1_beam/policy/policy.bin")), 1u);
+  EXPECT_EQ(formatVersion(policyFileBytes(ppo)), 1u);
+  EXPECT_EQ(formatVersion(policyFileBytes(fs::path(MASA_SOURCE_DIR) / "tasks/a1_beam/policy/policy.bin")), 1u);
   EXPECT_EQ(policy::loadPolicyFile(ppo.string()).model->config().squash, model::ActionSquash::kNone);
   fs::remove(sac);
   fs::remove(ppo);
@@ -222,9 +222,9 @@ TEST(SacPolicyFile, EveryShippedPpoPolicyStillLoadsAndActsWithItsUnsquashedMean)
 
 TEST(SacPolicyFile, ABitFlippedAtAnyByteIsRefusedNamingTheFile) {
   SacSetup s("a1_beam", "masa", true, 15);
-  const fs::path good = tempFile("flip_good"), bad = tempFile("flip_bad");
+  const fs::path good = sacTempFile("flip_good"), bad = sacTempFile("flip_bad");
   saveSacPolicyFile(good.string(), s.rc, s.sc, s.policy, s.spec);
-  const std::string bytes = slurp(good);
+  const std::string bytes = policyFileBytes(good);
   ASSERT_NO_THROW(policy::loadPolicyFile(good.string()));
   {
     std::ofstream(bad, std::ios::binary) << bytes;
@@ -279,7 +279,7 @@ TEST(SacPolicyFile, TheOnnxExportEndsInATanhThatMakesActionMean) {
 // (last action zero), the limits the runner keeps applied; rates and clips wide enough not to bind.
 TEST(SacPolicyFile, TheDeployRunnerCommandsTheTasksTargetsForTanhOfTheMean) {
   SacSetup s("a1_beam", "masa", true, 19);
-  const fs::path f = tempFile("deploy");
+  const fs::path f = sacTempFile("deploy");
   saveSacPolicyFile(f.string(), s.rc, s.sc, s.policy, s.spec);
   policy::LoadedPolicy lp = policy::loadPolicyFile(f.string());
   fs::remove(f);

@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 constexpr FileKind kToyKind{"masa toy", "TOYFMT01"};
 constexpr FileKind kOtherKind{"masa other", "OTHER001"};
 
-fs::path scratchDir(const std::string& name) {
+fs::path sealedDir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("masa_sealed_test_" + std::to_string(::getpid())) / name;
   fs::remove_all(d);
   fs::create_directories(d);
@@ -40,12 +40,12 @@ std::string toyPayload(std::size_t n) {
   return p;
 }
 
-std::string slurp(const fs::path& p) {
+std::string sealedBytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-std::string refusal(const std::string& bytes, const FileKind& kind = kToyKind, const ReadRules& rules = {}) {
+std::string sealedRefusal(const std::string& bytes, const FileKind& kind = kToyKind, const ReadRules& rules = {}) {
   try {
     openSealedBytes(bytes, "toy.bin", kind, rules);
   } catch (const std::runtime_error& e) {
@@ -59,7 +59,7 @@ TEST(Sha256, MatchesTheStandardTestVector) {
 }
 
 TEST(SealedFile, APayloadRoundTripsThroughAFileWrittenAtomically) {
-  const fs::path dir = scratchDir("roundtrip");
+  const fs::path dir = sealedDir("roundtrip");
   const std::string payload = toyPayload(1000);
   writeSealedFile((dir / "toy.bin").string(), kToyKind, payload);
   EXPECT_FALSE(fs::exists(dir / "toy.bin.tmp"));
@@ -78,22 +78,22 @@ TEST(SealedFile, EverySingleBitFlipAndEveryCutIsRefusedWithTheFileAndTheReason) 
     for (int bit = 0; bit < 8; ++bit) {
       std::string b = sealed;
       b[i] ^= static_cast<char>(1 << bit);
-      const std::string why = refusal(b);
+      const std::string why = sealedRefusal(b);
       ASSERT_NE(why, "") << "byte " << i << " bit " << bit << " flipped was accepted";
       ASSERT_EQ(why.rfind("toy.bin: ", 0), 0u) << why;
     }
   }
-  for (std::size_t n = 0; n < sealed.size(); ++n) ASSERT_NE(refusal(sealed.substr(0, n)), "") << "cut to " << n << " bytes";
-  EXPECT_EQ(refusal(sealed + "x"), "toy.bin: checksum mismatch (file corrupted or truncated: the seal holds 312 bytes, the file 313)");
+  for (std::size_t n = 0; n < sealed.size(); ++n) ASSERT_NE(sealedRefusal(sealed.substr(0, n)), "") << "cut to " << n << " bytes";
+  EXPECT_EQ(sealedRefusal(sealed + "x"), "toy.bin: checksum mismatch (file corrupted or truncated: the seal holds 312 bytes, the file 313)");
   std::string flipped = sealed;
   flipped[200] ^= 1;
-  EXPECT_EQ(refusal(flipped), "toy.bin: checksum mismatch (file corrupted or truncated)");
+  EXPECT_EQ(sealedRefusal(flipped), "toy.bin: checksum mismatch (file corrupted or truncated)");
 }
 
 TEST(SealedFile, OneKindIsNeverReadAsAnother) {
   const std::string sealed = sealBytes(kOtherKind, toyPayload(100));
-  EXPECT_EQ(refusal(sealed), "toy.bin: a masa other file, not a masa toy file");
-  EXPECT_NE(refusal("OTHER001 and the rest").find("not a masa toy file"), std::string::npos);
+  EXPECT_EQ(sealedRefusal(sealed), "toy.bin: a masa other file, not a masa toy file");
+  EXPECT_NE(sealedRefusal("OTHER001 and the rest").find("not a masa toy file"), std::string::npos);
 }
 
 TEST(SealedFile, AnUnsealedFileLoadsWithAWarningNamingItUnlessASignatureIsRequired) {
@@ -108,11 +108,11 @@ TEST(SealedFile, AnUnsealedFileLoadsWithAWarningNamingItUnlessASignatureIsRequir
   TrustedKeys trusted;
   ReadRules rules;
   rules.require_signed_by = &trusted;
-  EXPECT_NE(refusal(legacy, kToyKind, rules).find("toy.bin: not signed"), std::string::npos);
+  EXPECT_NE(sealedRefusal(legacy, kToyKind, rules).find("toy.bin: not signed"), std::string::npos);
 }
 
 TEST(SealedFile, OnlyASignatureByATrustedKeyIsAcceptedWhereOneIsRequired) {
-  const fs::path dir = scratchDir("signed");
+  const fs::path dir = sealedDir("signed");
   const PublicKeyBytes release = generateKeyPair((dir / "release.key").string(), (dir / "release.pub").string());
   generateKeyPair((dir / "stranger.key").string(), (dir / "stranger.pub").string());
   const TrustedKeys trusted = TrustedKeys::load((dir / "release.pub").string());
@@ -123,10 +123,10 @@ TEST(SealedFile, OnlyASignatureByATrustedKeyIsAcceptedWhereOneIsRequired) {
   const std::string payload = toyPayload(500);
 
   writeSealedFile(path, kToyKind, payload);
-  EXPECT_NE(refusal(slurp(path), kToyKind, rules).find("not signed, and a signature by a trusted key is required"), std::string::npos);
+  EXPECT_NE(sealedRefusal(sealedBytes(path), kToyKind, rules).find("not signed, and a signature by a trusted key is required"), std::string::npos);
 
   signSealedFile(path, SigningKey::load((dir / "stranger.key").string()));
-  const std::string by_stranger = refusal(slurp(path), kToyKind, rules);
+  const std::string by_stranger = sealedRefusal(sealedBytes(path), kToyKind, rules);
   EXPECT_NE(by_stranger.find("which is not a trusted key"), std::string::npos) << by_stranger;
   EXPECT_EQ(readSealedFile(path, kToyKind).payload, payload) << "a valid signature by anyone is still an intact file";
 
@@ -138,11 +138,11 @@ TEST(SealedFile, OnlyASignatureByATrustedKeyIsAcceptedWhereOneIsRequired) {
   EXPECT_NE(f.describe().find("signed by " + keyFingerprint(release)), std::string::npos);
 
   // Every bit of a signed file matters, the signature's too, with or without a required signer.
-  const std::string signed_bytes = slurp(path);
+  const std::string signed_bytes = sealedBytes(path);
   for (std::size_t i = 0; i < signed_bytes.size(); i += (i < 80 || i + 120 > signed_bytes.size()) ? 1 : 7) {
     std::string b = signed_bytes;
     b[i] ^= static_cast<char>(1 << (i % 8));
-    ASSERT_NE(refusal(b), "") << "byte " << i;
+    ASSERT_NE(sealedRefusal(b), "") << "byte " << i;
   }
   // A directory of trusted keys holds every *.pub in it.
   const TrustedKeys both = TrustedKeys::load(dir.string());
@@ -150,7 +150,7 @@ TEST(SealedFile, OnlyASignatureByATrustedKeyIsAcceptedWhereOneIsRequired) {
 }
 
 TEST(SealedFile, KeysAreFilesThatAreNeverOverwrittenAndAPrivateKeyOthersMayReadIsRefused) {
-  const fs::path dir = scratchDir("keys");
+  const fs::path dir = sealedDir("keys");
   generateKeyPair((dir / "a.key").string(), (dir / "a.pub").string());
   struct stat st {};
   ASSERT_EQ(::stat((dir / "a.key").c_str(), &st), 0);
@@ -193,7 +193,7 @@ TEST(SealedFile, RandomMutationsAreRefusedUnlessTheyLeaveTheBytesAsTheyWere) {
       ++unchanged;
       continue;
     }
-    ASSERT_NE(refusal(m.bytes), "") << "mutation " << i << " (" << m.what << ") accepted";
+    ASSERT_NE(sealedRefusal(m.bytes), "") << "mutation " << i << " (" << m.what << ") accepted";
     ++refused;
   }
   EXPECT_GT(refused, 1900);

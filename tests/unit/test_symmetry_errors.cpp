@@ -13,7 +13,7 @@ namespace {
 const char* kSource = "bad_spec.yaml";
 
 // Runs parseString and returns the error; fails the test if nothing or something else is thrown.
-ConfigError errorOf(const std::string& yaml) {
+ConfigError specErrorOf(const std::string& yaml) {
   try {
     SymmetrySpec::parseString(yaml, kSource);
   } catch (const ConfigError& e) {
@@ -24,7 +24,7 @@ ConfigError errorOf(const std::string& yaml) {
 }
 
 void expectError(const std::string& yaml, const std::string& key, const std::string& fragment = "") {
-  const ConfigError e = errorOf(yaml);
+  const ConfigError e = specErrorOf(yaml);
   const std::string what = e.what();
   EXPECT_EQ(e.key(), key) << what;
   EXPECT_EQ(e.file(), kSource);

@@ -19,8 +19,8 @@ namespace {
 
 using namespace masa::test;
 
-const std::string kData = MASA_TEST_DATA_DIR;
-const std::string kSource = MASA_SOURCE_DIR;
+const std::string kFinderData = MASA_TEST_DATA_DIR;
+const std::string kFinderSource = MASA_SOURCE_DIR;
 
 std::string writeTemp(const std::string& name, const std::string& text) {
   const std::string path = ::testing::TempDir() + "/" + name;
@@ -28,7 +28,7 @@ std::string writeTemp(const std::string& name, const std::string& text) {
   return path;
 }
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
+std::string withReplaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from;
   if (at != std::string::npos) text.replace(at, from.size(), to);
@@ -94,7 +94,7 @@ class ShippedRobot : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ShippedRobot, FinderProposesTheShippedSymmetryAndThePhysicsConfirmsIt) {
   const std::string task = GetParam();
-  const std::string model_file = kSource + "/tasks/" + task + "/model.xml";
+  const std::string model_file = kFinderSource + "/tasks/" + task + "/model.xml";
   const auto shipped = shippedSpec(task);
   const auto found = findSymmetries(model_file);
   const SymmetryCandidate* c = candidateWithGroup(found, shipped.group());
@@ -115,7 +115,7 @@ INSTANTIATE_TEST_SUITE_P(SymmetryFinder, ShippedRobot,
 // Every other group the geometry proposes for a shipped robot is one the physics confirms too (the
 // ant's two mirrors); a group it refutes is not proposed.
 TEST(SymmetryFinder, EveryProposalForTheShippedAntIsConfirmed) {
-  const auto found = findSymmetries(kSource + "/tasks/ant_acrobatic/model.xml");
+  const auto found = findSymmetries(kFinderSource + "/tasks/ant_acrobatic/model.xml");
   ASSERT_EQ(found.proposed().size(), 3u);
   for (const auto* c : found.proposed()) EXPECT_TRUE(checkCandidate(found, *c, {.num_states = 3}).confirmed) << c->label;
 }
@@ -124,7 +124,7 @@ TEST(SymmetryFinder, EveryProposalForTheShippedAntIsConfirmed) {
 // spec, observation included, is the one the walker's YAML task ships with, but for the heading
 // (task state the model does not show).
 TEST(SymmetryFinder, ProposesC4ForTheWalkerWithUnnamedActuatorsAndItsYamlTaskObservation) {
-  const auto found = findSymmetries(kData + "/c4_walker.xml");
+  const auto found = findSymmetries(kFinderData + "/c4_walker.xml");
   ASSERT_FALSE(found.proposed().empty());
   const SymmetryCandidate& best = *found.proposed().front();
   EXPECT_EQ(best.label, "rotation C4 about z");
@@ -134,7 +134,7 @@ TEST(SymmetryFinder, ProposesC4ForTheWalkerWithUnnamedActuatorsAndItsYamlTaskObs
 
   const auto spec = specOf(found, best);
   const auto shipped = shippedSpec("c4_walker");
-  const auto model = MujocoModel::load(kData + "/c4_walker.xml");
+  const auto model = MujocoModel::load(kFinderData + "/c4_walker.xml");
   expectSameGroupAction(spec, shipped, model->get());
   // Observation: the same dimensions by name, and the same T_i between them.
   std::map<std::string, int> shipped_dim;
@@ -157,7 +157,7 @@ TEST(SymmetryFinder, ProposesC4ForTheWalkerWithUnnamedActuatorsAndItsYamlTaskObs
 
 // What --task-out writes is a task config: its env builds the YAML task over the spec --out writes.
 TEST(SymmetryFinder, TheWrittenTaskConfigBuildsAYamlTaskOverTheWrittenSpec) {
-  const auto found = findSymmetries(kSource + "/tasks/humanoid_tightrope/model.xml");
+  const auto found = findSymmetries(kFinderSource + "/tasks/humanoid_tightrope/model.xml");
   const SymmetryCandidate& best = *found.proposed().front();
   const std::string spec_path = writeTemp("found_humanoid.yaml", foundSpecYaml(found, best));
   const YAML::Node config = YAML::Load(foundTaskYaml(found, best, spec_path));
@@ -196,7 +196,7 @@ TEST(SymmetryFinder, AModelWithoutSymmetryGetsNoProposal) {
 // What the geometry cannot see, the physics refutes: one hip's motor twice as strong leaves every
 // joint where the symmetry wants it, so C4 and both mirrors are proposed, and none is confirmed.
 TEST(SymmetryFinder, AStrongerMotorOnOneLegLeavesNoConfirmedCandidate) {
-  const std::string xml = replaced(readTextFile(kData + "/c4_walker.xml"), R"(<motor joint="hip2"/>)",
+  const std::string xml = withReplaced(readTextFile(kFinderData + "/c4_walker.xml"), R"(<motor joint="hip2"/>)",
                                    R"(<motor joint="hip2" gear="40"/>)");
   const auto found = findSymmetries(writeTemp("walker_strong_hip.xml", xml));
   ASSERT_EQ(found.proposed().size(), 3u);
@@ -210,8 +210,8 @@ TEST(SymmetryFinder, AStrongerMotorOnOneLegLeavesNoConfirmedCandidate) {
 
 // A joint reversed in one leg is found as a sign (limb_signs), and the physics agrees.
 TEST(SymmetryFinder, AReversedKneeAxisBecomesALimbSign) {
-  std::string xml = readTextFile(kData + "/c4_walker.xml");
-  xml = replaced(xml, R"(<joint name="knee1" type="hinge" axis="0 1 0" range="-30 70"/>)",
+  std::string xml = readTextFile(kFinderData + "/c4_walker.xml");
+  xml = withReplaced(xml, R"(<joint name="knee1" type="hinge" axis="0 1 0" range="-30 70"/>)",
                  R"(<joint name="knee1" type="hinge" axis="0 -1 0" range="-70 30"/>)");
   const auto found = findSymmetries(writeTemp("walker_reversed_knee.xml", xml));
   ASSERT_FALSE(found.proposed().empty());
@@ -236,7 +236,7 @@ TEST(SymmetryFinder, BadInputIsRefusedWithTheFileAndTheReason) {
   const std::string broken = writeTemp("broken.xml", "<mujoco><worldbody><body name=\"a\"></worldbody></mujoco>");
   EXPECT_NE(message(broken).find(broken + ": MuJoCo could not load the model"), std::string::npos) << message(broken);
   const std::string passive = writeTemp(
-      "passive.xml", replaced(readTextFile(kData + "/c4_walker.xml"), R"(<motor joint="knee3"/>)", ""));
+      "passive.xml", withReplaced(readTextFile(kFinderData + "/c4_walker.xml"), R"(<motor joint="knee3"/>)", ""));
   EXPECT_EQ(message(passive), passive +
                                   ": joint 'knee3' has no actuator: the spec moves each hinge and slide with the action "
                                   "of the actuator that drives it");

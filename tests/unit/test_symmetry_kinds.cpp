@@ -91,7 +91,7 @@ action: {central: [{name: a, kind: polar_x}]}
   EXPECT_EQ(apply(spec.actTransform(1), Eigen::VectorXd::Constant(1, 2.0))(0), -2.0);
 }
 
-const char* kC3 = R"(
+const char* kC3Spec = R"(
 name: c3
 group: {type: rotation, axis: z, order: 3}
 observation:
@@ -108,7 +108,7 @@ action:
 )";
 
 TEST(SymmetryKinds, RotationTurnsVectorsByMinusTwoPiIOverN) {
-  const SymmetrySpec spec = SymmetrySpec::parseString(kC3, "c3.yaml");
+  const SymmetrySpec spec = SymmetrySpec::parseString(kC3Spec, "c3.yaml");
   ASSERT_EQ(spec.obsDim(), 3 + 4 + 2 + 1 + 3 * 4);
   Eigen::VectorXd o = Eigen::VectorXd::Random(spec.obsDim());
   for (int i = 0; i < 3; ++i) {
@@ -125,7 +125,7 @@ TEST(SymmetryKinds, RotationTurnsVectorsByMinusTwoPiIOverN) {
 }
 
 TEST(SymmetryKinds, RotationLeftMultipliesQuaternionByYaw) {
-  const SymmetrySpec spec = SymmetrySpec::parseString(kC3, "c3.yaml");
+  const SymmetrySpec spec = SymmetrySpec::parseString(kC3Spec, "c3.yaml");
   const Eigen::Quaterniond q(Eigen::AngleAxisd(1.1, Eigen::Vector3d(-0.2, 0.9, 0.4).normalized()));
   Eigen::VectorXd o = Eigen::VectorXd::Zero(spec.obsDim());
   o.segment(3, 4) << q.w(), q.x(), q.y(), q.z();
@@ -152,7 +152,7 @@ action: {central: [{name: u, kind: invariant}]}
 }
 
 TEST(SymmetryKinds, LimbBlocksShiftSoAgentIsLimbComesFirst) {
-  const SymmetrySpec spec = SymmetrySpec::parseString(kC3, "c3.yaml");
+  const SymmetrySpec spec = SymmetrySpec::parseString(kC3Spec, "c3.yaml");
   const int c = spec.obsCentralDim(), l = spec.obsLimbDim();
   Eigen::VectorXd o = Eigen::VectorXd::Zero(spec.obsDim());
   for (int k = 0; k < 3; ++k) {
@@ -217,7 +217,7 @@ action: {central: [{name: u, kind: odd}]}
 }
 
 TEST(SymmetryKinds, DimensionNamesFollowBlockEntryAndComponent) {
-  const SymmetrySpec spec = SymmetrySpec::parseString(kC3, "c3.yaml");
+  const SymmetrySpec spec = SymmetrySpec::parseString(kC3Spec, "c3.yaml");
   const auto& n = spec.obsNames();
   EXPECT_EQ(n[0], "central.p[0]");
   EXPECT_EQ(n[6], "central.q[3]");

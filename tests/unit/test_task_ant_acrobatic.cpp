@@ -16,10 +16,10 @@ namespace {
 
 using namespace masa::test;
 
-const std::string kTask = "ant_acrobatic";
+const std::string kAntTask = "ant_acrobatic";
 
 TEST(AntAcrobaticTask, LoadsAndRuns1000RandomStepsWithFiniteValues) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   auto t = f.create();
   ASSERT_EQ(t->obsDim(), 58);
   ASSERT_EQ(t->actDim(), 8);
@@ -29,7 +29,7 @@ TEST(AntAcrobaticTask, LoadsAndRuns1000RandomStepsWithFiniteValues) {
 }
 
 TEST(AntAcrobaticTask, ResetPutsAntOnBallWithUprightPoleAndCanonicalQuaternion) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   auto t = f.create();
   Rng rng(3);
   t->reset(rng);
@@ -45,7 +45,7 @@ TEST(AntAcrobaticTask, ResetPutsAntOnBallWithUprightPoleAndCanonicalQuaternion) 
 
 // Leg k must be leg 0 rotated by +90k deg about z, exactly: body offsets and joint axes.
 TEST(AntAcrobaticTask, ModelLegsAreExactRotationsOfLegZero) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   const mjModel* m = f.model()->get();
   auto rot = [](const double* v, int k, double* out) {  // +90k deg about z
     double x = v[0], y = v[1];
@@ -82,7 +82,7 @@ TEST(AntAcrobaticTask, ModelLegsAreExactRotationsOfLegZero) {
 }
 
 TEST(AntAcrobaticTask, ZeroActionEarnsExactlyTheAliveBonus) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   auto t = f.create();
   Rng rng(4);
   t->reset(rng);
@@ -94,7 +94,7 @@ TEST(AntAcrobaticTask, ZeroActionEarnsExactlyTheAliveBonus) {
 }
 
 TEST(AntAcrobaticTask, ActionAndEnergyCostsFollowTheAppendix) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   auto t = f.create();
   Rng rng(5);
   t->reset(rng);
@@ -122,7 +122,7 @@ TEST(AntAcrobaticTask, ActionAndEnergyCostsFollowTheAppendix) {
 }
 
 TEST(AntAcrobaticTask, TiltedPoleTerminatesWithMinusOne) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   auto t = f.create();
   Rng rng(6);
   t->reset(rng);
@@ -140,7 +140,7 @@ TEST(AntAcrobaticTask, TiltedPoleTerminatesWithMinusOne) {
 }
 
 TEST(AntAcrobaticTask, UprightPoleOutOfTheCupTerminates) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   auto t = f.create();
   Rng rng(7);
   t->reset(rng);
@@ -155,7 +155,7 @@ TEST(AntAcrobaticTask, UprightPoleOutOfTheCupTerminates) {
 }
 
 TEST(AntAcrobaticTask, AntOffTheBallTerminates) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   auto t = f.create();
   Rng rng(8);
   t->reset(rng);
@@ -167,7 +167,7 @@ TEST(AntAcrobaticTask, AntOffTheBallTerminates) {
 }
 
 TEST(AntAcrobaticTask, TimeLimitTruncatesWithoutPenalty) {
-  TaskFactory f = envFactory(kTask, editedEnv(kTask, [](YAML::Node& env) { env["max_episode_steps"] = 5; }));
+  TaskFactory f = envFactory(kAntTask, editedEnv(kAntTask, [](YAML::Node& env) { env["max_episode_steps"] = 5; }));
   auto t = f.create();
   Rng rng(9);
   t->reset(rng);
@@ -185,7 +185,7 @@ TEST(AntAcrobaticTask, TimeLimitTruncatesWithoutPenalty) {
 TEST(AntAcrobaticTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
   const TrajectoryOptions opt{.steps = 100};
   expectSameSeedBitIdenticalOtherSeedDiffers(
-      [&](std::uint64_t seed) { return recordTrajectory(envFactory(kTask), seed, opt); }, 11, 12);
+      [&](std::uint64_t seed) { return recordTrajectory(envFactory(kAntTask), seed, opt); }, 11, 12);
 }
 
 // Tolerance: a 90 deg rotation maps the model onto itself exactly (exact leg coordinates, elliptic
@@ -198,12 +198,12 @@ constexpr double kSymmetryTolerance = 1e-6;
 
 // The verifier on three states of the shipped task with `spec` in place of its own (a broken one).
 SymmetryReport verifyWithSpec(const sym::SymmetrySpec& spec, std::uint64_t seed) {
-  return verifySymmetry(envFactory(kTask, shippedEnv(kTask), spec),
+  return verifySymmetry(envFactory(kAntTask, shippedEnv(kAntTask), spec),
                         {.num_states = 3, .max_warmup_steps = 10, .seed = seed, .tolerance = kSymmetryTolerance});
 }
 
 TEST(AntAcrobaticTask, PhysicsSymmetryVerifierPasses) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kAntTask);
   const SymmetryReport r = verifySymmetry(
       f, {.num_states = 12, .max_warmup_steps = 40, .steps = 2, .seed = 21, .tolerance = kSymmetryTolerance});
   std::printf("%s", r.summary(4).c_str());
@@ -218,7 +218,7 @@ TEST(AntAcrobaticTask, PhysicsSymmetryVerifierPasses) {
 // must name the ankle joints. The observation map alone cannot see this: the same wrong sign is
 // applied to the state and to the observation.
 TEST(AntAcrobaticTask, WrongAnkleSignsFailTheVerifierNamingTheAnkles) {
-  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kAntTask, [](YAML::Node& root) {
     for (const char* block : {"observation", "action"})
       for (YAML::Node e : root[block]["limb"])
         if (e["name"].as<std::string>().rfind("ankle", 0) == 0) e["limb_signs"] = std::vector<int>{1, -1, -1, 1};
@@ -233,7 +233,7 @@ TEST(AntAcrobaticTask, WrongAnkleSignsFailTheVerifierNamingTheAnkles) {
 
 // Swapping two legs in mujoco.actuators breaks the rotation: the hips are named.
 TEST(AntAcrobaticTask, SwappedLegBindingFailsTheVerifier) {
-  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kAntTask, [](YAML::Node& root) {
     YAML::Node limbs = root["mujoco"]["actuators"]["limbs"];
     const YAML::Node l1 = YAML::Clone(limbs[1]);
     limbs[1] = YAML::Clone(limbs[3]);
@@ -247,7 +247,7 @@ TEST(AntAcrobaticTask, SwappedLegBindingFailsTheVerifier) {
 
 // A vector declared invariant: the observation map itself must fail, on the rotated components.
 TEST(AntAcrobaticTask, PoleUpDeclaredInvariantFailsTheObservationMap) {
-  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kAntTask, [](YAML::Node& root) {
     for (YAML::Node e : root["observation"]["central"])
       if (e["name"].as<std::string>() == "pole_up") {
         e["kind"] = "invariant";

@@ -12,7 +12,7 @@ namespace {
 
 using namespace masa::test;
 
-const std::string kData = MASA_TEST_DATA_DIR;
+const std::string kFrameworkData = MASA_TEST_DATA_DIR;
 
 class TwinArmTask : public Task {
  public:
@@ -78,9 +78,9 @@ std::unique_ptr<Task> makeTwinArm(std::shared_ptr<const MujocoModel> m, const sy
   return std::make_unique<TwinArmTask>(std::move(m), s, p);
 }
 
-sym::SymmetrySpec twinSpec() { return sym::SymmetrySpec::load(kData + "/twin_arm_spec.yaml"); }
+sym::SymmetrySpec twinSpec() { return sym::SymmetrySpec::load(kFrameworkData + "/twin_arm_spec.yaml"); }
 
-std::string specText() { return readTextFile(kData + "/twin_arm_spec.yaml"); }
+std::string specText() { return readTextFile(kFrameworkData + "/twin_arm_spec.yaml"); }
 
 // A test fixture, not in tasks/tasks.cpp's list: added once, before the first factory.
 void registerTwinArm() {

@@ -21,10 +21,10 @@ namespace {
 
 using namespace masa::test;
 
-const std::string kTask = "humanoid_dribbling";
+const std::string kDribblingTask = "humanoid_dribbling";
 
 TaskFactory quietFactory() {
-  return envFactory(kTask, editedEnv(kTask, [](YAML::Node& env) { env["reset_noise"] = 0.0; }));
+  return envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) { env["reset_noise"] = 0.0; }));
 }
 
 HumanoidDribbling& dribbling(std::unique_ptr<Task>& t) { return dynamic_cast<HumanoidDribbling&>(*t); }
@@ -35,7 +35,7 @@ double* ballQvel(Task& t) { return jointQvel(t, "ball"); }
 double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
 TEST(HumanoidDribblingTask, LoadsFromRunConfigAndRuns1000RandomStepsWithFiniteValues) {
-  const TaskFactory f = runConfigFactory(kTask);
+  const TaskFactory f = runConfigFactory(kDribblingTask);
   auto t = f.create();
   ASSERT_EQ(t->obsDim(), 80);
   ASSERT_EQ(t->actDim(), 21);
@@ -46,7 +46,7 @@ TEST(HumanoidDribblingTask, LoadsFromRunConfigAndRuns1000RandomStepsWithFiniteVa
 }
 
 TEST(HumanoidDribblingTask, ResetPlacesBallAheadAndDrawsARouteOfRandomTurns) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kDribblingTask);
   auto t = f.create();
   HumanoidDribbling& d = dribbling(t);
   int left = 0, right = 0;
@@ -185,7 +185,7 @@ TEST(HumanoidDribblingTask, FallingTerminatesWithExactlyMinusOne) {
 }
 
 TEST(HumanoidDribblingTask, TimeLimitTruncatesWithoutPenalty) {
-  TaskFactory f = envFactory(kTask, editedEnv(kTask, [](YAML::Node& env) { env["max_episode_steps"] = 4; }));
+  TaskFactory f = envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) { env["max_episode_steps"] = 4; }));
   auto t = f.create();
   Rng rng(0);
   t->reset(rng);
@@ -196,7 +196,7 @@ TEST(HumanoidDribblingTask, TimeLimitTruncatesWithoutPenalty) {
 }
 
 TEST(HumanoidDribblingTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kDribblingTask);
   // The route is random too: segment 1's heading joins each step's record.
   const TrajectoryOptions opt{.extra = [](const Task& t, std::vector<float>& out) {
     out.push_back(static_cast<float>(dynamic_cast<const HumanoidDribbling&>(t).segmentFrame(1).heading));
@@ -268,7 +268,7 @@ void expectMirrorCommutes(const MirrorMismatch& m) {
 }
 
 TEST(HumanoidDribblingTask, PhysicsSymmetryVerifierPasses) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kDribblingTask);
   const SymmetryReport r = verifySymmetry(f, {.num_states = 20, .steps = 3, .tolerance = kTolerance});
   EXPECT_TRUE(r.passed()) << r.summary();
   for (const auto& e : r.observation_map) EXPECT_EQ(e.error, 0.0) << e.name;  // segment 0 = world frame
@@ -276,7 +276,7 @@ TEST(HumanoidDribblingTask, PhysicsSymmetryVerifierPasses) {
 }
 
 TEST(HumanoidDribblingTask, SymmetryHoldsWithTheBallPressedAgainstAFoot) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kDribblingTask);
   auto t = f.create();
   Rng rng(5);
   t->reset(rng);
@@ -302,7 +302,7 @@ TEST(HumanoidDribblingTask, SymmetryHoldsWithTheBallPressedAgainstAFoot) {
 // Past a turn the segment frame is not the world frame: the mirror must carry the route along
 // (turns flip sign), or the observation and the rewards break.
 TEST(HumanoidDribblingTask, SymmetryHoldsPastATurnWithTheRouteMirrored) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kDribblingTask);
   auto t = f.create();
   HumanoidDribbling& d = dribbling(t);
   Rng rng(11);
@@ -331,11 +331,11 @@ TEST(HumanoidDribblingTask, SymmetryHoldsPastATurnWithTheRouteMirrored) {
 }
 
 TEST(HumanoidDribblingTask, BallPositionDeclaredAxialFailsTheObservationMapNamingIt) {
-  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kDribblingTask, [](YAML::Node& root) {
     for (YAML::Node e : root["observation"]["central"])
       if (e["name"].as<std::string>() == "ball_pos") e["kind"] = "axial3";
   });
-  const SymmetryReport r = verifySymmetry(envFactory(kTask, shippedEnv(kTask), broken),
+  const SymmetryReport r = verifySymmetry(envFactory(kDribblingTask, shippedEnv(kDribblingTask), broken),
                                           {.num_states = 5, .tolerance = kTolerance});
   EXPECT_FALSE(r.passed());
   for (const auto& e : r.observation_map) {
@@ -358,7 +358,7 @@ namespace {
 // the paper's behaviour (uncapped, absolute) stays the default.
 TEST(HumanoidDribblingTask, TheKickOptionsCapTheBallSpeedRewardAndSquareTheLateralPenalty) {
   const TaskFactory paper = quietFactory();
-  const TaskFactory capped = envFactory(kTask, editedEnv(kTask, [](YAML::Node& env) {
+  const TaskFactory capped = envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) {
                                           env["reset_noise"] = 0.0;
                                           env["velocity_cap"] = 1.5;
                                           env["lateral_penalty"] = "squared";
@@ -384,7 +384,7 @@ TEST(HumanoidDribblingTask, TheKickOptionsCapTheBallSpeedRewardAndSquareTheLater
   for (const auto& [key, value] : {std::pair<std::string, std::string>{"velocity_cap", "-1"},
                                    {"lateral_penalty", "cubic"}}) {
     try {
-      envFactory(kTask, editedEnv(kTask, [&](YAML::Node& env) { env[key] = value; }));
+      envFactory(kDribblingTask, editedEnv(kDribblingTask, [&](YAML::Node& env) { env[key] = value; }));
       ADD_FAILURE() << key << "=" << value << " was accepted";
     } catch (const std::exception& e) {
       EXPECT_NE(std::string(e.what()).find("env." + key), std::string::npos) << e.what();

@@ -17,13 +17,13 @@ namespace {
 
 using namespace masa::test;
 
-const std::string kTask = "humanoid_tightrope";
+const std::string kTightropeTask = "humanoid_tightrope";
 
 // The shipped env without reset noise: hand-made states start from the exact start pose.
 YAML::Node quietEnv() {
-  return editedEnv(kTask, [](YAML::Node& env) { env["reset_noise"] = 0.0; });
+  return editedEnv(kTightropeTask, [](YAML::Node& env) { env["reset_noise"] = 0.0; });
 }
-TaskFactory quietFactory() { return envFactory(kTask, quietEnv()); }
+TaskFactory quietTightropeFactory() { return envFactory(kTightropeTask, quietEnv()); }
 
 // Lifts the humanoid off the rope (no contact) and gives the root a world velocity.
 void floatWithVelocity(Task& t, double vx, double vy) {
@@ -36,7 +36,7 @@ void floatWithVelocity(Task& t, double vx, double vy) {
 }
 
 TEST(HumanoidTightropeTask, LoadsFromRunConfigAndRuns1000RandomStepsWithFiniteValues) {
-  const TaskFactory f = runConfigFactory(kTask);
+  const TaskFactory f = runConfigFactory(kTightropeTask);
   auto t = f.create();
   ASSERT_EQ(t->obsDim(), 74);
   ASSERT_EQ(t->actDim(), 21);
@@ -50,9 +50,9 @@ TEST(HumanoidTightropeTask, LoadsFromRunConfigAndRuns1000RandomStepsWithFiniteVa
 // The left side is the numerical mirror image of the right one, and each left hinge axis is the
 // mirrored right axis times the sign the spec declares (odd: -1): the spec and the model agree.
 TEST(HumanoidTightropeTask, ModelLeftSideIsTheMirrorOfTheRightWithTheSpecsJointSigns) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kTightropeTask);
   const mjModel* m = f.model()->get();
-  const sym::SymmetrySpec spec = shippedSpec(kTask);
+  const sym::SymmetrySpec spec = shippedSpec(kTightropeTask);
   const auto& right = spec.mujoco().limb_actuators[0];
   const auto& left = spec.mujoco().limb_actuators[1];
   const auto& kinds = spec.actionLayout().limb;
@@ -103,7 +103,7 @@ TEST(HumanoidTightropeTask, ModelLeftSideIsTheMirrorOfTheRightWithTheSpecsJointS
 }
 
 TEST(HumanoidTightropeTask, ResetStandsUprightWithAFootTouchingTheRopeTop) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kTightropeTask);
   auto t = f.create();
   for (int seed = 0; seed < 5; ++seed) {
     Rng rng(seed);
@@ -129,7 +129,7 @@ TEST(HumanoidTightropeTask, ResetStandsUprightWithAFootTouchingTheRopeTop) {
 }
 
 TEST(HumanoidTightropeTask, StandingStillEarnsNoVelocityRewardButTheAliveUpAndHeadingBonus) {
-  TaskFactory f = quietFactory();
+  TaskFactory f = quietTightropeFactory();
   auto t = f.create();
   Rng rng(0);
   t->reset(rng);
@@ -148,7 +148,7 @@ TEST(HumanoidTightropeTask, StandingStillEarnsNoVelocityRewardButTheAliveUpAndHe
 }
 
 TEST(HumanoidTightropeTask, VelocityRewardIsForwardSpeedAndLateralPenaltyIsSignless) {
-  TaskFactory f = quietFactory();
+  TaskFactory f = quietTightropeFactory();
   auto t = f.create();
   Rng rng(0);
   for (double vy : {0.3, -0.3}) {
@@ -165,7 +165,7 @@ TEST(HumanoidTightropeTask, VelocityRewardIsForwardSpeedAndLateralPenaltyIsSignl
 }
 
 TEST(HumanoidTightropeTask, HeadingAndUpFollowTheTorsoAxes) {
-  TaskFactory f = quietFactory();
+  TaskFactory f = quietTightropeFactory();
   auto t = f.create();
   Rng rng(0);
   t->reset(rng);
@@ -188,7 +188,7 @@ TEST(HumanoidTightropeTask, HeadingAndUpFollowTheTorsoAxes) {
 }
 
 TEST(HumanoidTightropeTask, ActionAndEnergyCostsFollowTheAppendix) {
-  TaskFactory f = quietFactory();
+  TaskFactory f = quietTightropeFactory();
   auto t = f.create();
   Rng rng(0);
   t->reset(rng);
@@ -217,7 +217,7 @@ TEST(HumanoidTightropeTask, ActionAndEnergyCostsFollowTheAppendix) {
 }
 
 TEST(HumanoidTightropeTask, TorsoFallingBelowStartMinus075TerminatesWithExactlyMinusOne) {
-  TaskFactory f = quietFactory();
+  TaskFactory f = quietTightropeFactory();
   auto t = f.create();
   Rng rng(0);
   t->reset(rng);
@@ -242,7 +242,7 @@ TEST(HumanoidTightropeTask, TorsoFallingBelowStartMinus075TerminatesWithExactlyM
 // the termination reward; the paper's task (0, the default) lets it lean until it falls.
 TEST(HumanoidTightropeTask, TiltPastMaxTiltTerminatesOnlyWhenTheOptionIsSet) {
   auto tiltedOutcome = [](double max_tilt_deg, double tilt_deg) {
-    TaskFactory f = envFactory(kTask, editedEnv(kTask, [&](YAML::Node& env) {
+    TaskFactory f = envFactory(kTightropeTask, editedEnv(kTightropeTask, [&](YAML::Node& env) {
                                  env["reset_noise"] = 0.0;
                                  env["max_tilt_deg"] = max_tilt_deg;
                                }));
@@ -267,7 +267,7 @@ TEST(HumanoidTightropeTask, TiltPastMaxTiltTerminatesOnlyWhenTheOptionIsSet) {
 TEST(HumanoidTightropeTask, MaxTiltOutsideZeroTo180IsAnErrorNamingTheKey) {
   for (double bad : {-5.0, 180.0}) {
     try {
-      TaskFactory f = envFactory(kTask, editedEnv(kTask, [&](YAML::Node& env) { env["max_tilt_deg"] = bad; }));
+      TaskFactory f = envFactory(kTightropeTask, editedEnv(kTightropeTask, [&](YAML::Node& env) { env["max_tilt_deg"] = bad; }));
       f.create();
       ADD_FAILURE() << "max_tilt_deg " << bad << " was accepted";
     } catch (const std::exception& e) {
@@ -277,7 +277,7 @@ TEST(HumanoidTightropeTask, MaxTiltOutsideZeroTo180IsAnErrorNamingTheKey) {
 }
 
 TEST(HumanoidTightropeTask, TimeLimitTruncatesWithoutPenalty) {
-  TaskFactory f = envFactory(kTask, editedEnv(kTask, [](YAML::Node& env) { env["max_episode_steps"] = 5; }));
+  TaskFactory f = envFactory(kTightropeTask, editedEnv(kTightropeTask, [](YAML::Node& env) { env["max_episode_steps"] = 5; }));
   auto t = f.create();
   Rng rng(0);
   t->reset(rng);
@@ -290,7 +290,7 @@ TEST(HumanoidTightropeTask, TimeLimitTruncatesWithoutPenalty) {
 }
 
 TEST(HumanoidTightropeTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
-  TaskFactory f = envFactory(kTask);
+  TaskFactory f = envFactory(kTightropeTask);
   expectSameSeedBitIdenticalOtherSeedDiffers([&](std::uint64_t seed) { return recordTrajectory(f, seed); }, 7, 8);
 }
 
@@ -298,16 +298,16 @@ TEST(HumanoidTightropeTask, SameSeedIsBitIdenticalAndDifferentSeedDiffers) {
 // constraint rows in another order; MuJoCo's Newton solver converges to ~1e-12 (measured worst
 // 2e-12 over 3 steps), and observations are exact sign flips. A wrong sign or swapped joint
 // gives errors of 1e-3 and more within one step, so 1e-8 separates the two by orders of magnitude.
-constexpr double kTolerance = 1e-8;
+constexpr double kTightropeTolerance = 1e-8;
 
 // The verifier on a few states of the shipped task with `spec` in place of its own.
-SymmetryReport verifyWithSpec(const sym::SymmetrySpec& spec) {
-  return verifySymmetry(envFactory(kTask, shippedEnv(kTask), spec), {.num_states = 5, .tolerance = kTolerance});
+SymmetryReport verifyTightropeWithSpec(const sym::SymmetrySpec& spec) {
+  return verifySymmetry(envFactory(kTightropeTask, shippedEnv(kTightropeTask), spec), {.num_states = 5, .tolerance = kTightropeTolerance});
 }
 
 TEST(HumanoidTightropeTask, PhysicsSymmetryVerifierPasses) {
-  TaskFactory f = envFactory(kTask);
-  const SymmetryReport r = verifySymmetry(f, {.num_states = 20, .steps = 3, .tolerance = kTolerance});
+  TaskFactory f = envFactory(kTightropeTask);
+  const SymmetryReport r = verifySymmetry(f, {.num_states = 20, .steps = 3, .tolerance = kTightropeTolerance});
   EXPECT_TRUE(r.passed()) << r.summary();
   // The observation map obs(T s) = T obs(s) holds exactly (signs only) on every entry.
   for (const auto& e : r.observation_map) EXPECT_EQ(e.error, 0.0) << e.name;
@@ -315,11 +315,11 @@ TEST(HumanoidTightropeTask, PhysicsSymmetryVerifierPasses) {
 }
 
 TEST(HumanoidTightropeTask, AnkleXDeclaredInvariantFailsTheVerifierNamingTheAnkles) {
-  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTightropeTask, [](YAML::Node& root) {
     for (YAML::Node e : root["action"]["limb"])
       if (e["name"].as<std::string>() == "ankle_x") e["kind"] = "invariant";
   });
-  const SymmetryReport r = verifyWithSpec(broken);
+  const SymmetryReport r = verifyTightropeWithSpec(broken);
   EXPECT_FALSE(r.passed());
   // The state map now keeps the ankle_x angles while the (odd) observation entries flip: the
   // observation map names exactly the six ankle_x entries.
@@ -341,14 +341,14 @@ TEST(HumanoidTightropeTask, AnkleXDeclaredInvariantFailsTheVerifierNamingTheAnkl
 // exact, so the dynamics must catch it; and since the noise-free start pose is mirror-symmetric, a
 // right T maps it onto itself, while the broken one moves exactly the swapped hip joints (x and z).
 TEST(HumanoidTightropeTask, HipsSwappedInTheActuatorBindingFailTheVerifier) {
-  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTightropeTask, [](YAML::Node& root) {
     YAML::Node limb = root["mujoco"]["actuators"]["limbs"][1];
     const std::string x = limb[3].as<std::string>();
     limb[3] = limb[5].as<std::string>();  // left_hip_z where left_hip_x belongs
     limb[5] = x;
   });
   for (const bool is_broken : {false, true}) {
-    TaskFactory f = envFactory(kTask, quietEnv(), is_broken ? broken : shippedSpec(kTask));
+    TaskFactory f = envFactory(kTightropeTask, quietEnv(), is_broken ? broken : shippedSpec(kTightropeTask));
     auto t = f.create();
     Rng rng(0);
     t->reset(rng);
@@ -362,7 +362,7 @@ TEST(HumanoidTightropeTask, HipsSwappedInTheActuatorBindingFailTheVerifier) {
       EXPECT_EQ(moved, is_broken && swapped) << name;
     }
   }
-  const SymmetryReport r = verifyWithSpec(broken);
+  const SymmetryReport r = verifyTightropeWithSpec(broken);
   EXPECT_FALSE(r.passed());
   for (const auto& e : r.observation_map) EXPECT_EQ(e.error, 0.0) << e.name;
   for (const auto& e : r.joints) {
@@ -373,11 +373,11 @@ TEST(HumanoidTightropeTask, HipsSwappedInTheActuatorBindingFailTheVerifier) {
 }
 
 TEST(HumanoidTightropeTask, RollDeclaredInvariantFailsTheObservationMapNamingIt) {
-  const sym::SymmetrySpec broken = editedSpec(kTask, [](YAML::Node& root) {
+  const sym::SymmetrySpec broken = editedSpec(kTightropeTask, [](YAML::Node& root) {
     for (YAML::Node e : root["observation"]["central"])
       if (e["name"].as<std::string>() == "torso_roll") e["kind"] = "invariant";
   });
-  const SymmetryReport r = verifyWithSpec(broken);
+  const SymmetryReport r = verifyTightropeWithSpec(broken);
   EXPECT_FALSE(r.passed());
   for (const auto& e : r.observation_map) {
     if (e.name == "central.torso_roll") {

@@ -33,7 +33,7 @@ struct Trace {
 };
 
 // Steps with random actions from `rng`, resetting at the ends of episodes from `reset_rng`.
-Trace drive(Task& t, Rng& rng, Rng& reset_rng, int steps) {
+Trace driveTask(Task& t, Rng& rng, Rng& reset_rng, int steps) {
   Trace trace;
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   std::vector<float> a(t.actDim());
@@ -61,7 +61,7 @@ TEST_P(TaskState, AnInstanceThatLoadsTheStateGoesOnAsTheOneThatSavedIt) {
   auto a = f.create(), b = f.create();
   Rng reset_a(11), act_a(12);
   a->reset(reset_a);
-  drive(*a, act_a, reset_a, 40);  // past one time limit: an episode under way, not a fresh one
+  driveTask(*a, act_a, reset_a, 40);  // past one time limit: an episode under way, not a fresh one
   ASSERT_GT(a->episode().length, 0);
 
   std::vector<double> state;
@@ -69,11 +69,11 @@ TEST_P(TaskState, AnInstanceThatLoadsTheStateGoesOnAsTheOneThatSavedIt) {
   Rng reset_b = reset_a, act_b = act_a;
   Rng other(99);
   b->reset(other);
-  drive(*b, other, other, 7);  // b is somewhere else entirely before it loads
+  driveTask(*b, other, other, 7);  // b is somewhere else entirely before it loads
   b->loadState(state);
   EXPECT_EQ(observation(*b), observation(*a)) << "the observation right after loading";
 
-  const Trace ta = drive(*a, act_a, reset_a, 45), tb = drive(*b, act_b, reset_b, 45);
+  const Trace ta = driveTask(*a, act_a, reset_a, 45), tb = driveTask(*b, act_b, reset_b, 45);
   ASSERT_EQ(ta.obs.size(), tb.obs.size());
   EXPECT_EQ(0, std::memcmp(ta.obs.data(), tb.obs.data(), ta.obs.size() * sizeof(float))) << "observations differ";
   ASSERT_EQ(ta.numbers.size(), tb.numbers.size());
@@ -91,7 +91,7 @@ INSTANTIATE_TEST_SUITE_P(EveryTask, TaskState,
                                            "humanoid_dribbling", "a1_beam_yaml", "ant_acrobatic_yaml"));
 
 // Why loadState refused `state` ("" when it took it).
-std::string refusal(Task& t, const std::vector<double>& state) {
+std::string stateRefusal(Task& t, const std::vector<double>& state) {
   try {
     t.loadState(state);
   } catch (const std::runtime_error& e) {
@@ -109,7 +109,7 @@ TEST(TaskStateRefused, AnotherTaskCutShortOrAWrongExtrasCountIsRefusedByName) {
   std::vector<double> state;
   ant->saveState(state);
   auto expectRefused = [](Task& t, const std::vector<double>& s, const std::string& why) {
-    const std::string said = refusal(t, s);
+    const std::string said = stateRefusal(t, s);
     EXPECT_NE(said.find(why), std::string::npos) << "expected a refusal saying '" << why << "', got '" << said << "'";
   };
   expectRefused(*a1, state, "task state of a1_beam: nq is 29");  // another task's

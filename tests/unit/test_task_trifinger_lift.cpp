@@ -16,7 +16,7 @@ namespace {
 
 using namespace masa::test;
 
-const std::string kTask = "trifinger_lift";
+const std::string kTriFingerTask = "trifinger_lift";
 
 double tipDistanceSum(const Task& t) {
   const mjModel* m = t.model();
@@ -40,7 +40,7 @@ void putCubeAtGoal(Task& t, const Eigen::Vector3d& offset) {
 }
 
 TEST(TrifingerLift, LoadsAndRunsThousandRandomStepsWithFiniteValues) {
-  const TaskFactory f = runConfigFactory(kTask);
+  const TaskFactory f = runConfigFactory(kTriFingerTask);
   auto t = f.create();
   ASSERT_EQ(t->obsDim(), 41);
   ASSERT_EQ(t->actDim(), 9);
@@ -51,7 +51,7 @@ TEST(TrifingerLift, LoadsAndRunsThousandRandomStepsWithFiniteValues) {
 }
 
 TEST(TrifingerLift, FingersAndWallAreExactRotationsOfFingerZero) {
-  const TaskFactory f = runConfigFactory(kTask);
+  const TaskFactory f = runConfigFactory(kTriFingerTask);
   auto t = f.create();
   const mjModel* m = t->model();
   mjData* d = t->data();
@@ -84,7 +84,7 @@ TEST(TrifingerLift, FingersAndWallAreExactRotationsOfFingerZero) {
 }
 
 TEST(TrifingerLift, CubeAtGoalSucceedsAndThreeCentimetresAwayDoesNot) {
-  const TaskFactory f = runConfigFactory(kTask);
+  const TaskFactory f = runConfigFactory(kTriFingerTask);
   auto t = f.create();
   const std::vector<float> hold(9, 0.0f);
   for (int seed = 0; seed < 5; ++seed) {
@@ -108,7 +108,7 @@ TEST(TrifingerLift, CubeAtGoalSucceedsAndThreeCentimetresAwayDoesNot) {
 }
 
 TEST(TrifingerLift, ReachTermRewardsTheDecreaseOfFingertipToCubeDistance) {
-  const TaskFactory f = runConfigFactory(kTask);
+  const TaskFactory f = runConfigFactory(kTriFingerTask);
   auto t = f.create();
   Rng rng(3);
   t->reset(rng);
@@ -124,7 +124,7 @@ TEST(TrifingerLift, ReachTermRewardsTheDecreaseOfFingertipToCubeDistance) {
 }
 
 TEST(TrifingerLift, EpisodeTruncatesAt750StepsWithoutTerminationPenalty) {
-  const TaskFactory f = runConfigFactory(kTask);
+  const TaskFactory f = runConfigFactory(kTriFingerTask);
   auto t = f.create();
   Rng rng(4);
   t->reset(rng);
@@ -144,7 +144,7 @@ TEST(TrifingerLift, EpisodeTruncatesAt750StepsWithoutTerminationPenalty) {
 }
 
 TEST(TrifingerLift, SameSeedIsBitIdenticalDifferentSeedDiffers) {
-  const TaskFactory f = runConfigFactory(kTask);
+  const TaskFactory f = runConfigFactory(kTriFingerTask);
   const TrajectoryOptions opt{.steps = 100, .observe = TrajectoryOptions::Observe::kBeforeStep};
   expectSameSeedBitIdenticalOtherSeedDiffers([&](std::uint64_t seed) { return recordTrajectory(f, seed, opt); }, 7, 8);
 }
@@ -153,13 +153,13 @@ TEST(TrifingerLift, SameSeedIsBitIdenticalDifferentSeedDiffers) {
 // states that agree to 1e-13 may round to neighbouring floats; the observed worst is ~1e-7. The
 // simulator states themselves agree to ~1e-13 after a step (exact rotations of an exactly rotated
 // scene, contacts included), so joints and reward are held to 1e-9.
-constexpr double kTolerance = 1e-5;
+constexpr double kTriFingerTolerance = 1e-5;
 
 TEST(TrifingerLift, PhysicsSymmetryCheckPassesAndObservationIsEquivariant) {
-  const TaskFactory f = runConfigFactory(kTask);
-  const SymmetryReport r = verifySymmetry(f, {.num_states = 20, .max_warmup_steps = 100, .tolerance = kTolerance});
+  const TaskFactory f = runConfigFactory(kTriFingerTask);
+  const SymmetryReport r = verifySymmetry(f, {.num_states = 20, .max_warmup_steps = 100, .tolerance = kTriFingerTolerance});
   EXPECT_TRUE(r.passed()) << r.summary(8);
-  EXPECT_LT(worstError(r.observation_map), kTolerance) << r.summary(8);
+  EXPECT_LT(worstError(r.observation_map), kTriFingerTolerance) << r.summary(8);
   EXPECT_LT(r.reward_error, 1e-9) << r.summary(8);
   for (const auto& e : r.joints) EXPECT_LT(e.error, 1e-9) << e.name;
 }
@@ -169,8 +169,8 @@ TEST(TrifingerLift, PhysicsSymmetryCheckPassesAndObservationIsEquivariant) {
 // the angle; pi keeps the uniform goal (errors up to pi, about 2.2 rad on average), drawn exactly as
 // before; the physics symmetry check still passes with the curriculum on.
 TEST(TrifingerLift, TheGoalCurriculumBoundsTheStartingOrientationErrorAndKeepsTheSymmetry) {
-  const TaskFactory near = runConfigFactory(kTask, {"env.goal_max_angle=0.5"});
-  const TaskFactory uniform = runConfigFactory(kTask);
+  const TaskFactory near = runConfigFactory(kTriFingerTask, {"env.goal_max_angle=0.5"});
+  const TaskFactory uniform = runConfigFactory(kTriFingerTask);
   auto a = near.create();
   auto b = uniform.create();
   double largest_near = 0, mean_uniform = 0;
@@ -187,11 +187,11 @@ TEST(TrifingerLift, TheGoalCurriculumBoundsTheStartingOrientationErrorAndKeepsTh
   EXPECT_LE(largest_near, 0.5 + 1e-9);
   EXPECT_GT(largest_near, 0.3) << "the angles fill the range";
   EXPECT_GT(mean_uniform, 1.6) << "the default goal stays uniform";
-  const SymmetryReport r = verifySymmetry(near, {.num_states = 10, .max_warmup_steps = 100, .tolerance = kTolerance});
+  const SymmetryReport r = verifySymmetry(near, {.num_states = 10, .max_warmup_steps = 100, .tolerance = kTriFingerTolerance});
   EXPECT_TRUE(r.passed()) << r.summary(8);
   for (const std::string bad : {"0", "-0.1", "3.5"}) {
     try {
-      runConfigFactory(kTask, {"env.goal_max_angle=" + bad});
+      runConfigFactory(kTriFingerTask, {"env.goal_max_angle=" + bad});
       ADD_FAILURE() << "goal_max_angle " << bad << " was accepted";
     } catch (const std::exception& ex) {
       EXPECT_NE(std::string(ex.what()).find("env.goal_max_angle"), std::string::npos) << ex.what();
@@ -203,10 +203,10 @@ TEST(TrifingerLift, TheGoalCurriculumBoundsTheStartingOrientationErrorAndKeepsTh
 // side), so claiming that fingers 1 and 2 measure it with the opposite sign must be refuted by the
 // simulation, naming an upper joint.
 TEST(TrifingerLift, FlippedUpperJointSignInTheSpecFailsTheCheckNamingIt) {
-  const TaskFactory f = runConfigFactory(kTask, editedSpec(kTask, [](YAML::Node& root) {
+  const TaskFactory f = runConfigFactory(kTriFingerTask, editedSpec(kTriFingerTask, [](YAML::Node& root) {
     root["action"]["limb"][0]["limb_signs"] = YAML::Load("[1, -1, -1]");
   }));
-  const SymmetryReport r = verifySymmetry(f, {.num_states = 3, .tolerance = kTolerance});
+  const SymmetryReport r = verifySymmetry(f, {.num_states = 3, .tolerance = kTriFingerTolerance});
   ASSERT_FALSE(r.passed());
   const NamedError worst = worstEntry(r.joints);
   EXPECT_TRUE(worst.name == "finger0_upper" || worst.name == "finger2_upper") << r.summary(8);

@@ -26,9 +26,9 @@ namespace {
 
 using model::Method;
 
-const Method kAllMethods[] = {Method::kMasa, Method::kSa, Method::kSasa, Method::kMa};
+const Method kTd3Methods[] = {Method::kMasa, Method::kSa, Method::kSasa, Method::kMa};
 
-SacPolicyShape smallShape(Method method) {
+SacPolicyShape smallTd3Shape(Method method) {
   SacPolicyShape s;
   s.method = method;
   s.hidden = {16, 12};
@@ -56,7 +56,7 @@ TEST(Td3Noise, TheSmoothingNoiseAndTheActionAreClipped) {
 // max over i, b of the violations of a(T o, T eps) = T a(o, eps) for the target-smoothing noise.
 double noisyActionSymmetry(const sym::SymmetrySpec& spec, Method method) {
   Rng rng(4);
-  SacPolicy<float> p(spec, smallShape(method));
+  SacPolicy<float> p(spec, smallTd3Shape(method));
   p.initialize(rng, 1.0f);
   const int o = spec.obsDim(), a = spec.actDim(), b = 7;
   Mat<float> obs(o, b), eps(a, b), act(a, b), tobs(o, b), teps(a, b), tact(a, b), want(a, b);
@@ -95,7 +95,7 @@ struct Td3Fixture {
 
   Td3Fixture(const char* yaml, Method method, uint64_t seed = 11)
       : spec(test::spec(yaml, "spec")),
-        policy(spec, smallShape(method)),
+        policy(spec, smallTd3Shape(method)),
         q(spec, twinQMaps(method, spec), {9, 6}, nn::Activation::kElu),
         q_target(spec, twinQMaps(method, spec), {9, 6}, nn::Activation::kElu) {
     Rng rng(seed);
@@ -140,7 +140,7 @@ TEST(Td3Symmetry, MasaActorLossIsInvariantAndSaIsNot) {
 
 TEST(Td3Gradient, CriticAndActorLossesMatchFiniteDifferencesForEveryMethod) {
   for (const char* yaml : {test::kMirrorSpec, test::kC4Spec})
-    for (Method method : kAllMethods) {
+    for (Method method : kTd3Methods) {
       Td3Fixture<double> f(yaml, method);
       Td3Trainer<double> trainer(f.spec, f.policy, f.q, f.q_target, f.config);
       const std::string what = std::string(f.spec.name()) + " " + model::methodName(method);
@@ -171,7 +171,7 @@ TEST(Td3TrainerSteps, TheCriticTargetIsTheSmoothedTargetPolicyThroughTheTargetQs
   f.policy.params().values() *= 1.7;  // the online policy is no longer the target
   Rng r(5), expect(5);
   const double loss = trainer.criticLoss(f.batch, r);
-  SacPolicy<double> target(f.spec, smallShape(Method::kMasa));
+  SacPolicy<double> target(f.spec, smallTd3Shape(Method::kMasa));
   target.params().values() = target_params;
   const int a = f.spec.actDim(), b = f.batch.size();
   Mat<double> next_n, eps(a, b), act(a, b), min_q(1, b), obs_n, dq(2, b);
@@ -242,7 +242,7 @@ TEST(Td3TrainerSteps, AResumedTrainerTakesTheSameNextStepBitForBit) {
     ReplayBuffer rb;
     Rng rng;
     Run(const sym::SymmetrySpec& spec, const SacConfig& c, uint64_t seed)
-        : policy(spec, smallShape(Method::kMasa)),
+        : policy(spec, smallTd3Shape(Method::kMasa)),
           q(spec, twinQMaps(Method::kMasa, spec), {9, 6}, nn::Activation::kElu),
           q_target(spec, twinQMaps(Method::kMasa, spec), {9, 6}, nn::Activation::kElu),
           trainer(spec, policy, q, q_target, c),
@@ -283,7 +283,7 @@ TEST(Td3TrainerSteps, AResumedTrainerTakesTheSameNextStepBitForBit) {
 // A one-step bandit: reward -(a - 0.5)^2 on each action entry. TD3's tanh(mean) moves to 0.5.
 TEST(Td3TrainerSteps, LearnsTheBestActionOfABandit) {
   const auto spec = test::spec(test::kMirrorSpec, "spec");
-  SacPolicy<float> policy(spec, smallShape(Method::kSa));
+  SacPolicy<float> policy(spec, smallTd3Shape(Method::kSa));
   offline::TwinQ<float> q(spec, twinQMaps(Method::kSa, spec), {32, 32}, nn::Activation::kElu),
       q_target(spec, twinQMaps(Method::kSa, spec), {32, 32}, nn::Activation::kElu);
   SacConfig config;

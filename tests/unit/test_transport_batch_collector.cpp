@@ -21,7 +21,7 @@ using testing::fillRandomRollout;
 using testing::RolloutShape;
 
 constexpr RolloutShape kShape{6, 4, 5, 2};  // 6 envs x 4 steps, tiny dims
-constexpr int64_t kRun = 3;
+constexpr int64_t kCollectorRun = 3;
 
 // Feeds rollouts of one actor through a real assembler into the collector under test.
 class Feeder {
@@ -29,7 +29,7 @@ class Feeder {
   explicit Feeder(int lag) : assembler_(config(lag)) {}
   static AssemblerConfig config(int lag) {
     AssemblerConfig c;
-    c.run_id = kRun;
+    c.run_id = kCollectorRun;
     c.horizon = kShape.horizon;
     c.obs_dim = kShape.obs_dim;
     c.act_dim = kShape.act_dim;
@@ -47,7 +47,7 @@ class Feeder {
                        (event_prob > 0 ? 2000 : 0);
     RolloutChunker chunker(budget);
     int accepted = 0;
-    for (const auto& c : chunker.split(rollout_, {kRun, 0, seq_++, version})) {
+    for (const auto& c : chunker.split(rollout_, {kCollectorRun, 0, seq_++, version})) {
       const Verdict v = assembler_.accept(c);
       if (v) {
         collector.add(*v.chunk);
@@ -65,7 +65,7 @@ class Feeder {
   int64_t seq_ = 0;
 };
 
-CollectorConfig collectorConfig(int num_envs, int lag, int capacity = 0) {
+CollectorConfig batchCollectorConfig(int num_envs, int lag, int capacity = 0) {
   CollectorConfig c;
   c.num_envs = num_envs;
   c.horizon = kShape.horizon;
@@ -79,7 +79,7 @@ CollectorConfig collectorConfig(int num_envs, int lag, int capacity = 0) {
 
 TEST(BatchCollector, EmitsABatchOnlyOnceEnoughEnvironmentsArrived) {
   Feeder feeder(0);
-  BatchCollector collector(collectorConfig(10, 0));
+  BatchCollector collector(batchCollectorConfig(10, 0));
   testing::TakenBatch batch(collector.config());
   EXPECT_EQ(feeder.send(collector, 0), 3);
   EXPECT_EQ(collector.bufferedEnvs(), 6);
@@ -99,7 +99,7 @@ TEST(BatchCollector, EmitsABatchOnlyOnceEnoughEnvironmentsArrived) {
 
 TEST(BatchCollector, LagZeroIsStrictlyOnPolicy) {
   Feeder feeder(0);
-  BatchCollector collector(collectorConfig(6, 0));
+  BatchCollector collector(batchCollectorConfig(6, 0));
   feeder.setLearnerVersion(2);
   collector.setLearnerVersion(2);
   EXPECT_EQ(feeder.send(collector, 1), 0);  // one version behind: refused at the gate
@@ -115,7 +115,7 @@ TEST(BatchCollector, LagZeroIsStrictlyOnPolicy) {
 
 TEST(BatchCollector, LagTwoMixesVersionsOldestFirstAndEvictsBeyondTheLag) {
   Feeder feeder(2);
-  BatchCollector collector(collectorConfig(6, 2, /*capacity=*/24));
+  BatchCollector collector(batchCollectorConfig(6, 2, /*capacity=*/24));
   feeder.setLearnerVersion(4);
   collector.setLearnerVersion(4);
   EXPECT_EQ(feeder.send(collector, 4), 3);
@@ -135,7 +135,7 @@ TEST(BatchCollector, LagTwoMixesVersionsOldestFirstAndEvictsBeyondTheLag) {
 
 TEST(BatchCollector, FullPoolMakesRoomByEvictingOlderVersionsOnly) {
   Feeder feeder(5);
-  BatchCollector collector(collectorConfig(6, 5, /*capacity=*/6));
+  BatchCollector collector(batchCollectorConfig(6, 5, /*capacity=*/6));
   feeder.setLearnerVersion(5);
   collector.setLearnerVersion(5);
   feeder.send(collector, 3);
@@ -150,7 +150,7 @@ TEST(BatchCollector, FullPoolMakesRoomByEvictingOlderVersionsOnly) {
 
 TEST(BatchCollector, EpisodesAndTruncationsFollowTheirEnvironmentIntoTheBatch) {
   Feeder feeder(0);
-  BatchCollector collector(collectorConfig(6, 0));
+  BatchCollector collector(batchCollectorConfig(6, 0));
   feeder.send(collector, 0, 0.3);
   testing::TakenBatch batch(collector.config());
   ASSERT_TRUE(take(collector, batch));
@@ -195,7 +195,7 @@ Events eventsOf(const rollout::Rollout& r) {
 TEST(BatchCollector, ReusedSlotsCarryOnlyTheEventsOfTheirNewEnvironments) {
   Feeder feeder(5);
   feeder.setLearnerVersion(5);  // versions 0..5 are all fresh enough
-  BatchCollector collector(collectorConfig(6, 5, /*capacity=*/12));
+  BatchCollector collector(batchCollectorConfig(6, 5, /*capacity=*/12));
   collector.setLearnerVersion(5);
   testing::TakenBatch batch(collector.config());
   feeder.send(collector, 0, 0.3);
@@ -214,7 +214,7 @@ TEST(BatchCollector, ReusedSlotsCarryOnlyTheEventsOfTheirNewEnvironments) {
   batch.buffer.checkFinalObs();
 
   // Eviction: a full pool of version 2 gives its slots to version 3.
-  BatchCollector full(collectorConfig(6, 5, /*capacity=*/6));
+  BatchCollector full(batchCollectorConfig(6, 5, /*capacity=*/6));
   full.setLearnerVersion(5);
   feeder.send(full, 2, 0.3);
   feeder.send(full, 3, 0.3);
@@ -229,7 +229,7 @@ TEST(BatchCollector, ReusedSlotsCarryOnlyTheEventsOfTheirNewEnvironments) {
 // truncations with them), the buffer shrinks to them, and the next full batch grows it back.
 TEST(BatchCollector, TakeShortTakesWhatArrivedOnceEnoughDid) {
   Feeder feeder(0);
-  BatchCollector collector(collectorConfig(10, 0));
+  BatchCollector collector(batchCollectorConfig(10, 0));
   testing::TakenBatch batch(collector.config());
   feeder.send(collector, 0, 0.3);  // 6 environments, with events
   EXPECT_FALSE(collector.takeShort(batch.buffer, 7, &batch.origin)) << "fewer than min_envs";

@@ -25,7 +25,7 @@ using testing::kTrifinger;
 using testing::RolloutShape;
 
 template <typename T>
-bool bitwiseEqual(const std::vector<T>& a, const std::vector<T>& b) {
+bool bitwiseSame(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
@@ -101,16 +101,16 @@ void expectSplitReassemblesExactly(const RolloutShape& shape, int budget, uint64
   testing::TakenBatch batch(p.collector.config());
   ASSERT_TRUE(take(p.collector, batch));
   const rollout::Rollout& b = batch.data();
-  EXPECT_TRUE(bitwiseEqual(b.obs, r.obs));
-  EXPECT_TRUE(bitwiseEqual(b.actions, r.actions));
-  EXPECT_TRUE(bitwiseEqual(b.mean, r.mean));
-  EXPECT_TRUE(bitwiseEqual(b.log_prob, r.log_prob));
-  EXPECT_TRUE(bitwiseEqual(b.reward, r.reward));
-  EXPECT_TRUE(bitwiseEqual(b.terminated, r.terminated));
-  EXPECT_TRUE(bitwiseEqual(b.truncated, r.truncated));
-  EXPECT_TRUE(bitwiseEqual(b.env_log_std, r.env_log_std));
-  EXPECT_TRUE(bitwiseEqual(b.final_index, r.final_index));
-  EXPECT_TRUE(bitwiseEqual(b.final_obs, r.final_obs));
+  EXPECT_TRUE(bitwiseSame(b.obs, r.obs));
+  EXPECT_TRUE(bitwiseSame(b.actions, r.actions));
+  EXPECT_TRUE(bitwiseSame(b.mean, r.mean));
+  EXPECT_TRUE(bitwiseSame(b.log_prob, r.log_prob));
+  EXPECT_TRUE(bitwiseSame(b.reward, r.reward));
+  EXPECT_TRUE(bitwiseSame(b.terminated, r.terminated));
+  EXPECT_TRUE(bitwiseSame(b.truncated, r.truncated));
+  EXPECT_TRUE(bitwiseSame(b.env_log_std, r.env_log_std));
+  EXPECT_TRUE(bitwiseSame(b.final_index, r.final_index));
+  EXPECT_TRUE(bitwiseSame(b.final_obs, r.final_obs));
   EXPECT_EQ(episodesByEnv(b), episodesByEnv(r));
   for (int e = 0; e < shape.num_envs; ++e) {
     EXPECT_EQ(batch.origin.env_index[e], e);

@@ -19,7 +19,7 @@ using test::editedEnv;
 using test::editedSpec;
 using test::envFactory;
 
-const std::string kData = MASA_TEST_DATA_DIR;
+const std::string kYamlData = MASA_TEST_DATA_DIR;
 constexpr const char* kWalker = "c4_walker";
 
 // The message of what building the task throws ("" when nothing is thrown).
@@ -114,7 +114,7 @@ TEST(YamlTask, AQuaternionAndItsNegativeAreObservedAlike) {
 // A sensor is read for the state the step ended in, not the one MuJoCo computed it for (the start
 // of the step's last substep): a framelinvel sensor on the torso equals the free joint's velocity.
 TEST(YamlTask, SensorsAreReadForTheStateTheStepEndsIn) {
-  std::string xml = test::readTextFile(kData + "/c4_walker.xml");
+  std::string xml = test::readTextFile(kYamlData + "/c4_walker.xml");
   xml = std::regex_replace(xml, std::regex("</actuator>"),
                            "</actuator>\n  <sensor><framelinvel name=\"torso_vel\" objtype=\"body\" objname=\"torso\"/>"
                            "</sensor>");
@@ -262,7 +262,7 @@ reset: {joint_noise: 0.3, velocity_noise: 0.3}
 )";
 
 TEST(YamlTask, MirrorRobotWithACentralJointAndACarriedBallIsProvenSymmetric) {
-  const sym::SymmetrySpec spec = sym::SymmetrySpec::load(kData + "/twin_arm_spec.yaml");
+  const sym::SymmetrySpec spec = sym::SymmetrySpec::load(kYamlData + "/twin_arm_spec.yaml");
   const TaskFactory f(task::taskCatalog(), "twin_arm_yaml", spec, YAML::Load(kTwinArmEnv));
   SymmetryVerifierOptions opt;
   opt.num_states = 6;
@@ -271,7 +271,7 @@ TEST(YamlTask, MirrorRobotWithACentralJointAndACarriedBallIsProvenSymmetric) {
   EXPECT_TRUE(r.passed()) << r.summary(8);
 
   // Under a mirror a world angular velocity is axial: declared a polar vector3, it is refused.
-  YAML::Node root = YAML::LoadFile(kData + "/twin_arm_spec.yaml");
+  YAML::Node root = YAML::LoadFile(kYamlData + "/twin_arm_spec.yaml");
   for (auto e : root["observation"]["central"])
     if (e["name"].as<std::string>() == "ball_ang_vel") e["kind"] = "vector3";
   YAML::Emitter out;

@@ -13,7 +13,7 @@
 namespace masa::task {
 namespace {
 
-constexpr double kTol = 1e-6;
+constexpr double kTwinTol = 1e-6;
 
 struct TwinRun {
   int steps = 0, episodes = 0, terminations = 0;
@@ -66,8 +66,8 @@ TwinRun runTwins(const std::string& task, std::uint64_t seed, int steps,
 void expectTwinsMatch(const std::string& task) {
   for (std::uint64_t seed : {0u, 7u}) {
     const TwinRun run = runTwins(task, seed, 400);
-    EXPECT_LT(run.worst_obs, kTol) << task << " seed " << seed;
-    EXPECT_LT(run.worst_term, kTol) << task << " seed " << seed;
+    EXPECT_LT(run.worst_obs, kTwinTol) << task << " seed " << seed;
+    EXPECT_LT(run.worst_term, kTwinTol) << task << " seed " << seed;
     EXPECT_EQ(run.outcome_mismatches, 0) << task << " seed " << seed;
     EXPECT_GE(run.terminations, 3) << task << " seed " << seed;
   }
@@ -79,8 +79,8 @@ TEST(YamlTaskTwin, A1BeamInYamlMatchesItsCppTaskTermByTerm) {
   expectTwinsMatch("a1_beam");
   // Stiff gains drive the torques into their limits (clamped by the PD loop, and by MuJoCo to ctrlrange).
   const TwinRun stiff = runTwins("a1_beam", 3, 200, {"env.actuation.kp=400"}, {"env.kp=400"});
-  EXPECT_LT(stiff.worst_obs, kTol);
-  EXPECT_LT(stiff.worst_term, kTol);
+  EXPECT_LT(stiff.worst_obs, kTwinTol);
+  EXPECT_LT(stiff.worst_term, kTwinTol);
   EXPECT_EQ(stiff.outcome_mismatches, 0);
 }
 
