@@ -167,6 +167,7 @@ if [ "$status" = 1 ]; then
   running=0
   ( flock -n 9 ) 9> "$out/.grid.lock" || running=1
   slots_now=$( [ "$running" = 1 ] && [ -f "$out/.slots" ] && wc -l < "$out/.slots" || nproc)
+  remote_slots=$( [ -f "$out/.slots" ] && grep -cvx localhost "$out/.slots" || true)
   echo "grid $out: $tasks / $methods / seeds $seeds, ${updates:-the recipe max_updates} updates a run;" \
        "$( [ "$running" = 1 ] && echo "running, $slots_now at a time" || echo "not running")"
   for t in $tasks; do for m in $methods; do for sd in $seeds; do
@@ -174,14 +175,18 @@ if [ "$status" = 1 ]; then
     # max_epochs: the key's name in run directories made before issue #32
     [ -n "$target" ] || target=$(sed -n 's/^ *max_\(updates\|epochs\): *\([0-9]*\).*/\2/p' "$dir/config.yaml" 2>/dev/null | head -1)
     [ -n "$target" ] || target=$(sed -n 's/^ *max_updates: *\([0-9]*\).*/\1/p' "$(recipe_file "$t")" 2>/dev/null | head -1)
-    state=waiting
+    state=waiting age=0
     if [ -f "$dir/done" ]; then state=done
     elif [ -f "$dir/metrics.csv" ]; then
-      state=stopped
-      [ "$running" = 1 ] && [ $(( $(date +%s) - $(stat -c %Y "$dir/metrics.csv") )) -lt 300 ] && state=running
+      state=stopped age=$(( $(date +%s) - $(stat -c %Y "$dir/metrics.csv") ))
+      # On this machine a run is running exactly when its masa_train is; elsewhere (--hosts) awk judges by age.
+      if [ "$running" = 1 ] && [ "$remote_slots" = 0 ]; then
+        pgrep -f -- "--run-dir $(realpath "$dir")( |\$)" > /dev/null && state=running
+        age=999999
+      fi
     fi
-    echo "$t $m $sd ${target:-0} $state $dir/metrics.csv"
-  done; done; done | awk -v slots="$slots_now" '
+    echo "$t $m $sd ${target:-0} $state $dir/metrics.csv $age"
+  done; done; done | awk -v slots="$slots_now" -v grid_running="$running" '
     { run[NR] = $0; t[NR] = $1; m[NR] = $2; s[NR] = $3; target[NR] = $4; state[NR] = $5; rows = 0; spu = ""
       if ($5 != "waiting") {
         n = 0
@@ -204,7 +209,12 @@ if [ "$status" = 1 ]; then
           sum[$1 " " $2] += spu; cnt[$1 " " $2]++; all += spu; nall++
         }
       }
-      done_rows[NR] = rows; speed[NR] = spu; last_eval[NR] = $5 == "waiting" ? "" : ev; count[$5]++ }
+      # A run of a running grid is running while its metrics.csv grows: a row within 5 of its updates
+      # (2 minutes at least, 5 before it has a speed); older, it was stopped (a grid stopped and started
+      # again goes on with other runs first).
+      if (state[NR] == "stopped" && grid_running == 1 && $7 < (spu == "" ? 300 : (5 * spu > 120 ? 5 * spu : 120)))
+        state[NR] = "running"
+      done_rows[NR] = rows; speed[NR] = spu; last_eval[NR] = $5 == "waiting" ? "" : ev; count[state[NR]]++ }
     END {
       total = 0; left = 0; eta = 0
       for (i = 1; i <= NR; i++) {

@@ -48,6 +48,23 @@ grep -Eq "a1_beam +masa +seed 0 .* last eval $last_eval\$" status.out || fail "-
 grep -Eq "a1_beam +sa +seed 0 +0/150 +waiting" status.out || fail "--status does not show sa waiting: $(cat status.out)"
 grep -Eq "^0 done, 0 running, 1 stopped, 1 waiting; $rows_at_kill of 300 updates .*ETA [0-9]+:[0-9]{2} h" status.out || \
   fail "--status summary: $(cat status.out)"
+# While a grid runs (its lock held, one slot here), a run is running exactly when its masa_train is:
+# the killed run, its metrics.csv seconds old, is stopped (--status said "running" for 5 minutes
+# after a stop before 2026-12-04), and running once a process trains it.
+[ -f grid/.slots ] && cp grid/.slots slots.kept
+echo localhost > grid/.slots
+( flock 9; sleep 4 ) 9> grid/.grid.lock & lock_pid=$!
+sleep 0.3
+"$src/experiments/grid.sh" --status --out grid > status_lock.out 2>&1 || fail "--status failed: $(cat status_lock.out)"
+grep -Eq "a1_beam +masa +seed 0 +$rows_at_kill/150 +stopped " status_lock.out && grep -q "^0 done, 0 running, 1 stopped" status_lock.out ||
+  fail "--status of a running grid calls the stopped run running: $(cat status_lock.out)"
+( exec -a "masa_train --run-dir $(realpath grid/a1_beam/masa_s0)" sleep 3 ) & fake_pid=$!
+sleep 0.3
+"$src/experiments/grid.sh" --status --out grid > status_run.out 2>&1 || fail "--status failed: $(cat status_run.out)"
+grep -Eq "a1_beam +masa +seed 0 +$rows_at_kill/150 +running " status_run.out ||
+  fail "--status does not see the run its masa_train trains: $(cat status_run.out)"
+kill "$fake_pid" "$lock_pid" 2>/dev/null; wait "$fake_pid" "$lock_pid" 2>/dev/null || true
+rm -f grid/.slots; [ -f slots.kept ] && mv slots.kept grid/.slots
 
 # 1b. The stopped grid recorded with its checkpoint (record_grid.sh --checkpoints, what a session
 # keeps when its machine goes), and without.
