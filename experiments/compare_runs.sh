@@ -14,12 +14,13 @@
 # the fewest any run has; a run with fewer than --updates is kept as unfinished and named.
 # --reference (default: the first label) is compared against every other label. Labels: letters,
 # digits, '.', '-'. --milestone [TASK:]COLUMN=LEVEL (repeatable) adds when each run first reaches
-# LEVEL (as grid.sh's). Refuses an existing DIR (--force replaces it). MASA_BUILD_DIR chooses the build.
+# LEVEL (COLUMN<=LEVEL: first falls to it), as grid.sh's. Refuses an existing DIR (--force replaces
+# it). MASA_BUILD_DIR chooses the build.
 set -euo pipefail
 caller=$(pwd)
 cd "$(dirname "$0")/.."
 abs() { case "$1" in /*) echo "$1" ;; *) echo "$caller/$1" ;; esac; }
-usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0; }
+usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1' "$0" | sed 's/^# \{0,1\}//'; exit 0; }  # the header, whole
 die() { echo "compare_runs.sh: $*" >&2; exit 2; }
 out="" updates="" reference="" force=0 pairs=() milestones=()
 while [ $# -gt 0 ]; do

@@ -20,8 +20,9 @@
 # checkout, built, at the same path; the run directory is copied there before and back after each
 # run (MASA_SSH and MASA_RSYNC choose the commands, default ssh and rsync).
 # --milestone [TASK:]COLUMN=LEVEL (repeatable): the verdict adds when each run's COLUMN (a metrics.csv
-# column, e.g. an evaluation figure) first reaches LEVEL; kept in grid.txt, it can be added to a
-# grid at any time (a rerun or --replot) without changing its runs.
+# column, e.g. an evaluation figure) first reaches LEVEL (COLUMN<=LEVEL: first falls to it, for an
+# error); kept in grid.txt, it can be added to a grid at any time (a rerun or --replot) without
+# changing its runs.
 # --recipe NAME: every run from configs/recipes/NAME.yaml (or that YAML file) instead of its task's
 # recipe, e.g. --recipe a1_beam_off_policy; --no-recipe: from the task's config alone.
 # MASA_BUILD_DIR chooses the build (default build).
@@ -53,13 +54,13 @@ while [ $# -gt 0 ]; do
     --replot) replot=1; shift ;;
     --extend) extend=$2; shift 2 ;;
     --status) status=1; shift ;;
-    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && !/^#/ { exit } NR > 1' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;  # the header, whole
     *) echo "grid.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
 for x in "${milestones[@]+"${milestones[@]}"}"; do
-  [[ "$x" =~ ^([A-Za-z0-9_]+:)?[A-Za-z0-9_]+=[-+]?[0-9.]+([eE][-+]?[0-9]+)?$ ]] || \
-    { echo "grid.sh: --milestone '$x': write [TASK:]COLUMN=LEVEL, e.g. eval_distance_m=5" >&2; exit 2; }
+  [[ "$x" =~ ^([A-Za-z0-9_]+:)?[A-Za-z0-9_]+(=|\<=|\>=)[-+]?[0-9.]+([eE][-+]?[0-9]+)?$ ]] || \
+    { echo "grid.sh: --milestone '$x': write [TASK:]COLUMN=LEVEL, e.g. eval_distance_m=5 (COLUMN<=LEVEL for an error)" >&2; exit 2; }
 done
 [ ${#milestones[@]} -eq 0 ] || [ "$status" = 0 ] || { echo "grid.sh: --status only reads; give --milestone with --replot" >&2; exit 2; }
 [ -n "$out" ] && out=$(abs "$out")
@@ -248,7 +249,7 @@ if [ -z "$extend" ]; then
 fi
 # A milestone whose column the grid's runs so far do not have is refused before anything changes.
 for x in "${milestones[@]+"${milestones[@]}"}"; do
-  t=${x%%=*}; column=${t#*:}; t=${t%"$column"}; t=${t%:}
+  t=${x%%=*}; t=${t%[<>]}; column=${t#*:}; t=${t%"$column"}; t=${t%:}  # [TASK:]COLUMN before =, <= or >=
   headers=$(for f in "$out"/${t:-*}/*_s*/metrics.csv; do [ ! -f "$f" ] || head -n 1 "$f"; done)
   [ -z "$headers" ] || tr ',' '\n' <<< "$headers" | grep -qxF "$column" || \
     { echo "grid.sh: --milestone $x: the runs of $out${t:+ ($t)} have no column '$column'" >&2; exit 2; }

@@ -5,6 +5,7 @@
 //   masa_compare experiments/results/a1_beam_grid            (DIR/<task>/<method>_s<seed>/metrics.csv)
 //   masa_compare DIR --reference masa --resamples 10000 --no-plot
 //   masa_compare DIR --milestone eval_distance_m=5     (when each run's evaluation first walks 5 m)
+//   masa_compare DIR --milestone 'eval_position_error_m<=0.05'   (a figure that falls: the cube first within 5 cm)
 // Writes DIR/<task>/curves/<metric>_<method>.dat (env_steps wall_s median q25 q75 n), curves.csv
 // (the same, one table), runs.csv (one row per run), compare.gp and compare.png; DIR/verdict.md,
 // DIR/compare_all.gp and DIR/compare_all.png (every task on one page). `gnuplot compare.gp` in
@@ -242,12 +243,14 @@ std::string panel(const std::string& prefix, const std::string& metric, const st
   return plot + "\n";
 }
 
-// A milestone, [TASK:]COLUMN=LEVEL: the env steps of the first row at which a run's COLUMN reaches
-// LEVEL (an evaluation figure: when the policy mean first walks 5 m), in the tasks that have it.
+// A milestone, [TASK:]COLUMN=LEVEL (or >=): the env steps of the first row at which a run's COLUMN
+// reaches LEVEL (an evaluation figure: when the policy mean first walks 5 m), in the tasks that
+// have it; [TASK:]COLUMN<=LEVEL for a figure that falls (when the cube is first within 5 cm).
 struct Milestone {
   std::string task;  // empty: every task with the column
   std::string column;
   double level = 0;
+  bool at_most = false;  // COLUMN<=LEVEL: reached when the column falls to the level
   std::string text;
   bool from_grid = false;  // grid.txt's: one that fits no task is noted, not fatal (the runs stand)
   std::string unmatched;   // why it fits no task, if it does not
@@ -255,21 +258,24 @@ struct Milestone {
 };
 
 Milestone parseMilestone(const std::string& text) {
-  static const std::regex form("(?:([A-Za-z0-9_]+):)?([A-Za-z0-9_]+)=([-+0-9.eE]+)");
+  static const std::regex form("(?:([A-Za-z0-9_]+):)?([A-Za-z0-9_]+)(<=|>=|=)([-+0-9.eE]+)");
   std::smatch m;
   Milestone out;
   char* end = nullptr;
   if (std::regex_match(text, m, form)) {
-    const std::string level = m[3];
+    const std::string level = m[4];
     out.level = std::strtod(level.c_str(), &end);
     if (end == level.c_str() + level.size() && std::isfinite(out.level)) {
       out.task = m[1];
       out.column = m[2];
+      out.at_most = m[3] == "<=";
       out.text = text;
       return out;
     }
   }
-  throw std::runtime_error("milestone '" + text + "': write [TASK:]COLUMN=LEVEL, e.g. eval_distance_m=5");
+  throw std::runtime_error("milestone '" + text +
+                           "': write [TASK:]COLUMN=LEVEL, e.g. eval_distance_m=5 (or COLUMN<=LEVEL for a figure "
+                           "that falls, e.g. eval_position_error_m<=0.05)");
 }
 
 // The command line's milestones, then the grid's (grid.txt lines "milestone=...") not among them.
@@ -371,7 +377,7 @@ void writeMilestone(std::ostream& verdict, Milestone& ms, const std::string& tas
     return;
   }
   ms.matched = true;
-  verdict << "Milestone " << ms.column << " >= " << shortest(ms.level)
+  verdict << "Milestone " << ms.column << (ms.at_most ? " <= " : " >= ") << shortest(ms.level)
           << ": the env steps of the first row at which it holds (an evaluation figure is known only "
           << "at the evaluations); a seed that never reaches it within the budget counts as later than "
           << "any that does.\n\n| method | seeds that reach it | per seed | median | " << reference
@@ -379,7 +385,8 @@ void writeMilestone(std::ostream& verdict, Milestone& ms, const std::string& tas
   std::map<std::string, std::vector<double>> reached;  // NaN: not within the budget
   for (const auto& m : methods)
     for (const Run* r : used.at(m))
-      reached[m].push_back(stats::firstReached(r->col("env_steps"), r->col(ms.column), ms.level, budget));
+      reached[m].push_back(ms.at_most ? stats::firstFallenTo(r->col("env_steps"), r->col(ms.column), ms.level, budget)
+                                      : stats::firstReached(r->col("env_steps"), r->col(ms.column), ms.level, budget));
   auto allReached = [](const std::vector<double>& v) {
     return std::none_of(v.begin(), v.end(), [](double x) { return std::isnan(x); });
   };
@@ -582,8 +589,8 @@ int main(int argc, char** argv) {
   app.add_option("--resamples", resamples, "bootstrap resamples")->check(CLI::Range(100, 1000000));
   app.add_flag("--no-plot", no_plot, "write the tables and gnuplot scripts, do not run gnuplot");
   app.add_option("--milestone", milestone_texts,
-                 "[TASK:]COLUMN=LEVEL: when each run's COLUMN first reaches LEVEL (repeatable; grid.txt "
-                 "lines milestone=... add theirs)");
+                 "[TASK:]COLUMN=LEVEL: when each run's COLUMN first reaches LEVEL; COLUMN<=LEVEL: first falls "
+                 "to it (repeatable; grid.txt lines milestone=... add theirs)");
   CLI11_PARSE(app, argc, argv);
 
   try {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 namespace masa::stats {
 
@@ -64,11 +65,24 @@ double firstCrossing(const std::vector<double>& x, const std::vector<double>& y,
   return kNaN;
 }
 
-double firstReached(const std::vector<double>& x, const std::vector<double>& y, double level, double x_max) {
-  if (x.size() != y.size()) throw std::invalid_argument("firstReached: x and y differ in length");
+namespace {
+// The x of the first point at x <= x_max whose y is at the level (`holds`); NaN values are skipped.
+template <class Holds>
+double firstWhere(const char* name, const std::vector<double>& x, const std::vector<double>& y, double x_max,
+                  Holds holds) {
+  if (x.size() != y.size()) throw std::invalid_argument(std::string(name) + ": x and y differ in length");
   for (size_t i = 0; i < x.size() && x[i] <= x_max; ++i)
-    if (!std::isnan(y[i]) && y[i] >= level) return x[i];
+    if (!std::isnan(y[i]) && holds(y[i])) return x[i];
   return kNaN;
+}
+}  // namespace
+
+double firstReached(const std::vector<double>& x, const std::vector<double>& y, double level, double x_max) {
+  return firstWhere("firstReached", x, y, x_max, [level](double v) { return v >= level; });
+}
+
+double firstFallenTo(const std::vector<double>& x, const std::vector<double>& y, double level, double x_max) {
+  return firstWhere("firstFallenTo", x, y, x_max, [level](double v) { return v <= level; });
 }
 
 std::vector<double> trailingMean(const std::vector<double>& y, int window) {

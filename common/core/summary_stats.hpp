@@ -30,6 +30,9 @@ double firstCrossing(const std::vector<double>& x, const std::vector<double>& y,
 // values are skipped; NaN when y never reaches the level at x <= x_max.
 double firstReached(const std::vector<double>& x, const std::vector<double>& y, double level, double x_max);
 
+// The same for a figure that should fall (an error): the x of the first point with y <= level.
+double firstFallenTo(const std::vector<double>& x, const std::vector<double>& y, double level, double x_max);
+
 // Trailing mean over `window` points (fewer at the start); NaN values are left out of the mean.
 std::vector<double> trailingMean(const std::vector<double>& y, int window);
 

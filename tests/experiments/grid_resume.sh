@@ -174,6 +174,12 @@ grep -q "have no column 'no_such_column'" ms3.out || fail "no reason given: $(ca
 grep -q "write \[TASK:\]COLUMN=LEVEL" ms4.out || fail "no reason given: $(cat ms4.out)"
 "$src/experiments/grid.sh" --replot --out grown --seeds "1 0" > ms5.out 2>&1 || fail "the grid's seeds in another order were refused: $(cat ms5.out)"
 cmp -s grid_before_ms.txt grown/grid.txt || fail "a refused milestone or a reordering changed grid.txt: $(diff grid_before_ms.txt grown/grid.txt)"
+# A milestone on a figure that falls (COLUMN<=LEVEL, an error): the first row at or below the level,
+# update 1 at 64 steps (read as "reaches 3" it would be update 3, 192 steps).
+"$src/experiments/grid.sh" --replot --out grown --milestone 'update<=3' > ms6.out 2>&1 || fail "a <= milestone was refused: $(cat ms6.out)"
+grep -q "^Milestone update <= 3:" grown/verdict.md || fail "no <= milestone in the verdict: $(cat grown/verdict.md)"
+grep -qx "| masa | 2 of 2 | s0 64, s1 64 | 64 |  |" grown/verdict.md || fail "masa's <= milestone row: $(cat grown/verdict.md)"
+grep -qx "milestone=update<=3" grown/grid.txt || fail "grid.txt does not keep the <= milestone: $(cat grown/grid.txt)"
 
 # 3c. record_grid.sh: the grid as experiments/results/ keeps it (redrawn, no checkpoints, policies
 # or per-run PNGs, with RECORD.txt); refused over an existing folder, while a grid runs, for a

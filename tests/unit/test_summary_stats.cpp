@@ -55,6 +55,18 @@ TEST(SummaryStats, FirstReachedIsTheFirstMeasurementAtTheLevel) {
   EXPECT_THROW(firstReached({0, 1}, {0}, 1.0, 1e9), std::invalid_argument);
 }
 
+TEST(SummaryStats, FirstFallenToIsTheFirstMeasurementAtOrBelowTheLevel) {
+  // An error measured at 0, 10, 20, 30: the first time it is at most the level, not interpolated.
+  EXPECT_DOUBLE_EQ(firstFallenTo({0, 5, 10, 20, 30}, {9, NAN, 6, 4, 1}, 5.0, 1e9), 20.0);
+  EXPECT_DOUBLE_EQ(firstFallenTo({0, 10, 20}, {9, 5, 1}, 5.0, 1e9), 10.0);  // reaching is enough
+  EXPECT_DOUBLE_EQ(firstFallenTo({0, 10, 20, 30}, {9, 4, 8, 1}, 5.0, 1e9), 10.0);  // the first time
+  EXPECT_DOUBLE_EQ(firstFallenTo({5, 10}, {1, 7}, 5.0, 1e9), 5.0);
+  // A rising figure above the level has not fallen to it (firstReached would say 10).
+  EXPECT_TRUE(std::isnan(firstFallenTo({0, 10, 20}, {6, 7, 9}, 5.0, 1e9)));
+  EXPECT_TRUE(std::isnan(firstFallenTo({0, 10, 20}, {9, 8, 1}, 5.0, 15.0)));  // beyond x_max
+  EXPECT_THROW(firstFallenTo({0, 1}, {0}, 1.0, 1e9), std::invalid_argument);
+}
+
 TEST(SummaryStats, TrailingMeanAveragesThePastWindow) {
   const auto m = trailingMean({1, 2, 3, 4, NAN, 6}, 3);
   ASSERT_EQ(m.size(), 6u);
