@@ -122,7 +122,7 @@ void HumanoidDribbling::computeRewardTerms(double* t) const {
 }
 
 bool HumanoidDribbling::isTerminated() const {
-  return torsoPos()[2] < start_z_ - fall_height_ || torsoBallDistance() > max_ball_distance_;
+  return torsoPos()[2] < start_z_ - fall_height_ || torsoBallDistance() > max_ball_distance_ || tiltedPastLimit();
 }
 
 void HumanoidDribbling::afterStep() {

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
+
+#include "common/core/config_error.hpp"
 
 namespace masa::task {
 
@@ -32,6 +35,12 @@ HumanoidTask::HumanoidTask(std::string name, std::shared_ptr<const MujocoModel> 
   reset_noise_ = params.number("reset_noise", 0.01);
   start_hip_x_ = params.number("start_hip_x", start_hip_x_default);
   MASA_CHECK(reset_noise_ >= 0.0, "env.reset_noise must not be negative");
+  // No steps spent falling from a lean the humanoid cannot recover (the authors' later versions).
+  const double max_tilt_deg = params.number("max_tilt_deg", 0.0);
+  if (max_tilt_deg < 0.0 || max_tilt_deg >= 180.0)
+    throw ConfigError(params.origin("max_tilt_deg"), "env.max_tilt_deg",
+                      "must be in [0, 180) degrees (0: no tilt termination), got " + std::to_string(max_tilt_deg));
+  min_up_z_ = max_tilt_deg > 0.0 ? std::cos(max_tilt_deg * M_PI / 180.0) : -2.0;
   for (int k = 0; k < actDim(); ++k) {
     const int q = m->jnt_qposadr[jointOfAction(k)];
     const bool hip_x = std::find(hip_x_qpos_.begin(), hip_x_qpos_.end(), q) != hip_x_qpos_.end();
@@ -149,6 +158,12 @@ double HumanoidTask::actionSquaredNorm() const {
   double s = 0.0;
   for (double a : lastAction()) s += a * a;
   return s;
+}
+
+bool HumanoidTask::tiltedPastLimit() const {
+  double r[9];
+  torsoRotation(r);
+  return r[8] < min_up_z_;  // the torso's z axis' world z: the cosine of its tilt
 }
 
 }  // namespace masa::task

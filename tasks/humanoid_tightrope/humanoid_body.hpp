@@ -1,5 +1,6 @@
 // What the humanoid tasks (tightrope, dribbling) share: the 21-actuator humanoid's observation
-// blocks in the spec layout, its standing start pose, and its energy term.
+// blocks in the spec layout, its standing start pose, its energy term, and the optional end of an
+// episode on a tilted torso (env.max_tilt_deg).
 //
 // Every quantity is read from qpos/qvel (never from xpos/xmat, which mj_step leaves one substep
 // behind), so an observation after step() equals the same observation after mj_forward: the
@@ -60,6 +61,9 @@ class HumanoidTask : public Task {
   const double* torsoLinVel() const;  // world, m/s
   void torsoRotation(double* mat) const;  // row-major 3x3, torso frame -> world
   double actionSquaredNorm() const;
+  // env.max_tilt_deg (the authors' later Isaac Lab tasks: 30): true once the torso's z axis tilts
+  // more than that from upright; never with 0, the default (the paper's tasks). Mirror-invariant.
+  bool tiltedPastLimit() const;
 
  private:
   void writeJoints(int first_action, int n, float* out) const;
@@ -70,6 +74,7 @@ class HumanoidTask : public Task {
   std::vector<int> foot_geoms_;
   std::vector<int> hip_x_qpos_;
   double reset_noise_, start_hip_x_;
+  double min_up_z_ = -2.0;  // tiltedPastLimit below this cosine of the tilt (-2: never)
   std::vector<double> start_pose_;  // the start pose without noise, action order
 };
 

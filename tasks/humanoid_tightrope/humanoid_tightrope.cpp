@@ -3,7 +3,6 @@
 #include <cmath>
 #include <string>
 
-#include "common/core/config_error.hpp"
 
 #include "tasks/tasks.hpp"
 #include "tasks/humanoid_tightrope/humanoid_body.hpp"
@@ -30,13 +29,6 @@ class HumanoidTightrope final : public HumanoidTask {
     rope_radius_ = m->geom_size[3 * rope];
     fall_height_ = params.positive("fall_height", 0.75);
     up_threshold_ = params.number("up_threshold", 0.93);
-    // The authors' later version (Isaac Lab) also ends an episode once the torso tilts past 30
-    // degrees: no steps spent falling from a lean it cannot recover. 0 keeps the paper's task.
-    const double max_tilt_deg = params.number("max_tilt_deg", 0.0);
-    if (max_tilt_deg < 0.0 || max_tilt_deg >= 180.0)
-      throw ConfigError(params.origin("max_tilt_deg"), "env.max_tilt_deg",
-                        "must be in [0, 180) degrees (0: no tilt termination), got " + std::to_string(max_tilt_deg));
-    min_up_z_ = max_tilt_deg > 0.0 ? std::cos(max_tilt_deg * M_PI / 180.0) : -2.0;
   }
 
   // Metres walked along the rope (+x) from the start, and the mean speed over the episode.
@@ -73,12 +65,7 @@ class HumanoidTightrope final : public HumanoidTask {
     t[6] = std::abs(v[1]);                    // lateral: |v_y|, mirror-invariant (the paper's v_y is not)
   }
 
-  bool isTerminated() const override {
-    if (torsoPos()[2] < start_z_ - fall_height_) return true;
-    double r[9];
-    torsoRotation(r);
-    return r[8] < min_up_z_;  // the torso's z axis' world z: the cosine of its tilt, mirror-invariant
-  }
+  bool isTerminated() const override { return torsoPos()[2] < start_z_ - fall_height_ || tiltedPastLimit(); }
 
   void saveExtras(std::vector<double>& out) const override { out.insert(out.end(), {start_z_, start_x_}); }
   void loadExtras(std::span<const double> in) override {
@@ -90,7 +77,6 @@ class HumanoidTightrope final : public HumanoidTask {
 
  private:
   double rope_axis_z_ = 0.0, rope_radius_ = 0.0, fall_height_ = 0.0, up_threshold_ = 0.0;
-  double min_up_z_ = -2.0;  // terminate below this cosine of the tilt (-2: never)
   double start_z_ = 0.0, start_x_ = 0.0;  // x: along the rope, unchanged by the mirror
 };
 
