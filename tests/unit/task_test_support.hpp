@@ -148,6 +148,45 @@ inline double* jointQvel(task::Task& t, const char* joint) {
   return t.data()->qvel + t.model()->jnt_dofadr[jointId(t, joint)];
 }
 
+// ---- The humanoids' tilt termination (env.max_tilt_deg, tasks/humanoid_tightrope/humanoid_body) --
+
+// One zero-action step of a humanoid task after its torso was pitched forward by tilt_deg in place
+// (the free joint "root": its height, and the task's other terminations, stay as they were), with
+// env.max_tilt_deg set to max_tilt_deg and no reset noise.
+inline task::StepOutcome stepWithTorsoTilted(const std::string& task_name, double max_tilt_deg, double tilt_deg) {
+  task::TaskFactory f = envFactory(task_name, editedEnv(task_name, [&](YAML::Node& env) {
+                                     env["reset_noise"] = 0.0;
+                                     env["max_tilt_deg"] = max_tilt_deg;
+                                   }));
+  auto t = f.create();
+  Rng rng(0);
+  t->reset(rng);
+  const double half = 0.5 * tilt_deg * M_PI / 180.0;
+  double* q = jointQpos(*t, "root") + 3;  // the quaternion: w, x, y, z
+  q[0] = std::cos(half), q[1] = 0.0, q[2] = std::sin(half), q[3] = 0.0;
+  mj_forward(t->model(), t->data());
+  return stepZero(*t);
+}
+
+// The paper's task (0) never ends on a tilt; 30 degrees lets 20 pass and ends 40 with exactly the
+// termination reward; values outside [0, 180) are refused naming the key.
+inline void expectTiltTerminationOnlyWhenSet(const std::string& task_name) {
+  EXPECT_FALSE(stepWithTorsoTilted(task_name, 0.0, 60.0).terminated);
+  EXPECT_FALSE(stepWithTorsoTilted(task_name, 30.0, 20.0).terminated);
+  const task::StepOutcome o = stepWithTorsoTilted(task_name, 30.0, 40.0);
+  EXPECT_TRUE(o.terminated);
+  EXPECT_FALSE(o.truncated);
+  EXPECT_EQ(o.reward, -1.0);
+  for (double bad : {-5.0, 180.0}) {
+    try {
+      envFactory(task_name, editedEnv(task_name, [&](YAML::Node& env) { env["max_tilt_deg"] = bad; })).create();
+      ADD_FAILURE() << task_name << ": max_tilt_deg " << bad << " was accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("env.max_tilt_deg"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // ---- Random rollouts and determinism -----------------------------------------------------------
 
 struct RandomStepChecks {

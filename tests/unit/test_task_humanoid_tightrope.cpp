@@ -241,39 +241,7 @@ TEST(HumanoidTightropeTask, TorsoFallingBelowStartMinus075TerminatesWithExactlyM
 // env.max_tilt_deg (the authors' later version: 30): a torso tilted past it ends the episode with
 // the termination reward; the paper's task (0, the default) lets it lean until it falls.
 TEST(HumanoidTightropeTask, TiltPastMaxTiltTerminatesOnlyWhenTheOptionIsSet) {
-  auto tiltedOutcome = [](double max_tilt_deg, double tilt_deg) {
-    TaskFactory f = envFactory(kTightropeTask, editedEnv(kTightropeTask, [&](YAML::Node& env) {
-                                 env["reset_noise"] = 0.0;
-                                 env["max_tilt_deg"] = max_tilt_deg;
-                               }));
-    auto t = f.create();
-    Rng rng(0);
-    t->reset(rng);
-    // Pitch the torso forward about its y axis (the free joint's quaternion: w, x, y, z), in place.
-    const double half = 0.5 * tilt_deg * M_PI / 180.0;
-    double* q = t->data()->qpos + 3;
-    q[0] = std::cos(half), q[1] = 0.0, q[2] = std::sin(half), q[3] = 0.0;
-    mj_forward(t->model(), t->data());
-    return stepZero(*t);
-  };
-  EXPECT_FALSE(tiltedOutcome(0.0, 60.0).terminated);   // the paper's task: no tilt termination
-  EXPECT_FALSE(tiltedOutcome(30.0, 20.0).terminated);  // inside the bound
-  const StepOutcome o = tiltedOutcome(30.0, 40.0);
-  EXPECT_TRUE(o.terminated);
-  EXPECT_FALSE(o.truncated);
-  EXPECT_EQ(o.reward, -1.0);
-}
-
-TEST(HumanoidTightropeTask, MaxTiltOutsideZeroTo180IsAnErrorNamingTheKey) {
-  for (double bad : {-5.0, 180.0}) {
-    try {
-      TaskFactory f = envFactory(kTightropeTask, editedEnv(kTightropeTask, [&](YAML::Node& env) { env["max_tilt_deg"] = bad; }));
-      f.create();
-      ADD_FAILURE() << "max_tilt_deg " << bad << " was accepted";
-    } catch (const std::exception& e) {
-      EXPECT_NE(std::string(e.what()).find("env.max_tilt_deg"), std::string::npos) << e.what();
-    }
-  }
+  expectTiltTerminationOnlyWhenSet(kTightropeTask);
 }
 
 TEST(HumanoidTightropeTask, TimeLimitTruncatesWithoutPenalty) {
