@@ -41,6 +41,10 @@ HumanoidDribbling::HumanoidDribbling(std::shared_ptr<const MujocoModel> model, c
   if (lateral != "abs" && lateral != "squared")
     throw ConfigError(params.origin("lateral_penalty"), "env.lateral_penalty", "must be abs or squared, got '" + lateral + "'");
   lateral_squared_ = lateral == "squared";
+  const std::string anchor = params.text("route_anchor", "torso");
+  if (anchor != "torso" && anchor != "ball")
+    throw ConfigError(params.origin("route_anchor"), "env.route_anchor", "must be torso or ball, got '" + anchor + "'");
+  anchor_ball_ = anchor == "ball";
   segment_min_ = params.positive("segment_length_min", 4.0);
   segment_max_ = params.positive("segment_length_max", 8.0);
   turn_min_ = params.number("turn_min_deg", 30.0) * kDeg;
@@ -126,11 +130,12 @@ bool HumanoidDribbling::isTerminated() const {
 }
 
 void HumanoidDribbling::afterStep() {
-  // Re-anchor at each turn the torso has passed (along-track distance beyond the segment's end).
-  const double* t = torsoPos();
+  // Re-anchor at each turn the torso (or the ball) has passed (along-track distance beyond the
+  // segment's end).
+  const double* p = anchor_ball_ ? ballPos() : torsoPos();
   while (current_ + 1 < numSegments()) {
     const PlanarFrame& f = route_[current_];
-    const double along = std::cos(f.heading) * (t[0] - f.x) + std::sin(f.heading) * (t[1] - f.y);
+    const double along = std::cos(f.heading) * (p[0] - f.x) + std::sin(f.heading) * (p[1] - f.y);
     if (along < length_[current_]) break;
     ++current_;
   }

@@ -1,6 +1,6 @@
 // Humanoid Dribbling (paper appendix "Tasks Details"): dribble a ball along a route of straight
 // segments with random turns; observations are expressed in the current segment's frame, which is
-// re-anchored when the torso passes the segment's end. See README.md.
+// re-anchored when the torso (env.route_anchor: ball, the ball) passes the segment's end. See README.md.
 #pragma once
 
 #include <vector>
@@ -47,6 +47,10 @@ class HumanoidDribbling final : public HumanoidTask {
   // uncapped, the paper), and its lateral speed penalized squared instead of absolute.
   double velocity_cap_ = 0.0;
   bool lateral_squared_ = false;
+  // Issue #31 (the turns): which body's passing a segment's end moves the frame, and the reward's
+  // "along the route", on to the next segment. The torso (the default) lets the ball, ahead of it,
+  // roll past the turn while its speed along the old heading still pays; the ball turns them with it.
+  bool anchor_ball_ = false;
   double segment_min_, segment_max_, turn_min_, turn_max_;
   std::vector<PlanarFrame> route_;
   std::vector<double> length_;

@@ -315,6 +315,67 @@ TEST(HumanoidDribblingTask, SymmetryHoldsWithTheBallPressedAgainstAFoot) {
 
 // Past a turn the segment frame is not the world frame: the mirror must carry the route along
 // (turns flip sign), or the observation and the rewards break.
+// env.route_anchor: ball: the ball past the turn moves the frame on while the torso is still on
+// segment 0 (with the default, the torso, it does not); the ball then rolls across the new
+// segment's line, so its speed pays as lateral, not along the old heading.
+TEST(HumanoidDribblingTask, WithTheBallAsAnchorTheBallPassingTheTurnReanchors) {
+  struct AfterTheTurn {
+    int segment;
+    double velocity_term, ball_vx, ball_vy, heading1;
+  };
+  auto ballPassesTheTurn = [](const std::string& anchor) {
+    TaskFactory f = envFactory(kDribblingTask, editedEnv(kDribblingTask, [&](YAML::Node& env) {
+                                 env["reset_noise"] = 0.0;
+                                 env["route_anchor"] = anchor;
+                               }));
+    auto t = f.create();
+    HumanoidDribbling& d = dribbling(t);
+    Rng rng(3);
+    t->reset(rng);
+    const double l0 = d.segmentLength(0);
+    t->data()->qpos[0] = l0 - 0.5;  // the torso 0.5 m before the turn, on segment 0 (along +x)
+    ballQpos(*t)[0] = l0 + 0.1;     // the ball 0.1 m past it, rolling on along +x
+    ballQvel(*t)[0] = 1.0;
+    ballQvel(*t)[4] = 1.0 / 0.11;  // rolling, not sliding (radius 0.11 m)
+    mj_forward(t->model(), t->data());
+    stepZero(*t);
+    return AfterTheTurn{d.currentSegment(), rewardTerm(*t, "velocity"), ballQvel(*t)[0], ballQvel(*t)[1],
+                        d.segmentFrame(1).heading};
+  };
+  const AfterTheTurn torso = ballPassesTheTurn("torso");
+  EXPECT_EQ(torso.segment, 0);
+  EXPECT_GT(torso.ball_vx, 0.9);
+  EXPECT_NEAR(torso.velocity_term, 2.0 * torso.ball_vx, 1e-9);  // weight 2 x the speed along segment 0
+  const AfterTheTurn ball = ballPassesTheTurn("ball");
+  EXPECT_EQ(ball.segment, 1);
+  EXPECT_NEAR(ball.velocity_term, 2.0 * (ball.ball_vx * std::cos(ball.heading1) + ball.ball_vy * std::sin(ball.heading1)),
+              1e-9);  // along segment 1: the turn (30-90 degrees) takes its share away
+  EXPECT_LT(ball.velocity_term, 0.9 * torso.velocity_term);
+  try {
+    envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) { env["route_anchor"] = "head"; })).create();
+    ADD_FAILURE() << "route_anchor 'head' was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("env.route_anchor"), std::string::npos) << e.what();
+  }
+}
+
+// The mirror maps the ball's passing of a turn onto the mirrored ball passing the mirrored turn.
+TEST(HumanoidDribblingTask, SymmetryHoldsWithTheBallAsAnchorAtATurn) {
+  TaskFactory f = envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) { env["route_anchor"] = "ball"; }));
+  auto t = f.create();
+  HumanoidDribbling& d = dribbling(t);
+  Rng rng(11);
+  t->reset(rng);
+  const double l0 = d.segmentLength(0);
+  t->data()->qpos[0] = l0 - 0.6;
+  ballQpos(*t)[0] = l0 - 0.02;  // about to pass the turn: a mirrored step must pass it too
+  ballQvel(*t)[0] = 1.5;
+  mj_forward(t->model(), t->data());
+  expectMirrorCommutes(mirrorMismatch(f, *t, 5, rng));
+  stepZero(*t);
+  EXPECT_EQ(d.currentSegment(), 1);
+}
+
 TEST(HumanoidDribblingTask, SymmetryHoldsPastATurnWithTheRouteMirrored) {
   TaskFactory f = envFactory(kDribblingTask);
   auto t = f.create();
