@@ -75,6 +75,13 @@ fi
 [ -n "$hosts" ] && hosts=$(abs "$hosts")
 build=${MASA_BUILD_DIR:-build}
 [ -x "$build/tools/masa_train" ] || { echo "grid.sh: $build/tools/masa_train is missing: run scripts/build.sh first" >&2; exit 2; }
+# The comparison: the build's masa_compare, else this checkout's (a frozen build may hold only
+# masa_train; masa_compare reads the metrics.csv of runs of any commit).
+compare=$build/tools/masa_compare
+if [ ! -x "$compare" ] && [ -x build/tools/masa_compare ]; then
+  [ "$status" = 1 ] || echo "grid.sh: $build has no masa_compare: the comparison will use this checkout's build/tools/masa_compare" >&2
+  compare=build/tools/masa_compare
+fi
 
 # --extend: the grid in DIR, locked like a running grid (see below), gets the new number of
 # updates, and its finished runs lose their `done` marks; the rest is a resume.
@@ -354,4 +361,5 @@ if [ "$replot" = 0 ]; then
   rm -f "$queue" "$lock" "$slots"
 fi
 
-"$build/tools/masa_compare" "$out"
+[ -x "$compare" ] || { echo "grid.sh: no masa_compare in $build or build/: the runs are done; build it (scripts/build.sh) and draw the comparison with grid.sh --replot --out $out" >&2; exit 1; }
+"$compare" "$out"

@@ -181,6 +181,20 @@ grep -q "^Milestone update <= 3:" grown/verdict.md || fail "no <= milestone in t
 grep -qx "| masa | 2 of 2 | s0 64, s1 64 | 64 |  |" grown/verdict.md || fail "masa's <= milestone row: $(cat grown/verdict.md)"
 grep -qx "milestone=update<=3" grown/grid.txt || fail "grid.txt does not keep the <= milestone: $(cat grown/grid.txt)"
 
+# 3b'''. A build without masa_compare (a frozen one may hold masa_train alone): the comparison falls
+# back on this checkout's build/tools/masa_compare and says so, or, without one, says how to draw it.
+mkdir -p trainonly/tools && ln -sf "$build/tools/masa_train" trainonly/tools/masa_train
+rm -f grown/verdict.md
+if [ -x "$src/build/tools/masa_compare" ]; then
+  MASA_BUILD_DIR=$PWD/trainonly "$src/experiments/grid.sh" --replot --out grown > nocmp.out 2>&1 || fail "--replot with a build without masa_compare failed: $(cat nocmp.out)"
+  grep -q "has no masa_compare: the comparison will use this checkout's build/tools/masa_compare" nocmp.out && [ -s grown/verdict.md ] || \
+    fail "no fallback to the checkout's masa_compare: $(cat nocmp.out)"
+else
+  MASA_BUILD_DIR=$PWD/trainonly "$src/experiments/grid.sh" --replot --out grown > nocmp.out 2>&1 && fail "--replot without any masa_compare succeeded"
+  grep -q "no masa_compare in .* or build/: the runs are done" nocmp.out || fail "no reason given: $(cat nocmp.out)"
+  "$src/experiments/grid.sh" --replot --out grown > /dev/null 2>&1 || fail "--replot with the build failed"
+fi
+
 # 3c. record_grid.sh: the grid as experiments/results/ keeps it (redrawn, no checkpoints, policies
 # or per-run PNGs, with RECORD.txt); refused over an existing folder, while a grid runs, for a
 # folder that is no grid, and over the grid itself.
