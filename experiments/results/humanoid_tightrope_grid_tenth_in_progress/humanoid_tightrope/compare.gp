@@ -5,7 +5,7 @@ set termoption noenhanced
 set style fill transparent solid 0.2 noborder
 set grid
 set key bottom right
-set multiplot layout 3,2 title 'humanoid_tightrope: median and 25-75% over 2 seeds per method'
+set multiplot layout 3,2 title 'humanoid_tightrope: median and 25-75% over 3 seeds per method'
 set title 'training return (trailing mean of 5 updates)'
 set xlabel 'env steps (millions)'
 plot 'curves/return_masa.dat' using ($1/1e6):4:5 with filledcurves lc rgb '#d62728' notitle, 'curves/return_masa.dat' using ($1/1e6):3 with lines lw 2 lc rgb '#d62728' title 'masa', \
