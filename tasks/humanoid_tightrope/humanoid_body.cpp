@@ -161,6 +161,7 @@ double HumanoidTask::actionSquaredNorm() const {
 }
 
 bool HumanoidTask::tiltedPastLimit() const {
+  if (min_up_z_ < -1.0) return false;  // off (the paper's tasks): no rotation to compute each step
   double r[9];
   torsoRotation(r);
   return r[8] < min_up_z_;  // the torso's z axis' world z: the cosine of its tilt
