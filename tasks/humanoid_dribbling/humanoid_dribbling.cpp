@@ -1,5 +1,6 @@
 #include "tasks/humanoid_dribbling/humanoid_dribbling.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -13,7 +14,27 @@ namespace masa::task {
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
+constexpr int kBallObs = 6;      // the ball's position and velocity
+constexpr int kNextTurnObs = 3;  // env.observe_next_turn: the turn's distance ahead, the next heading
+
+// Read before the humanoid body checks the spec's layout, which depends on it: a spec without the
+// next turn's entries (or with them, and the option off) is named here with the way out.
+int extraCentralObs(EnvParams& params, const sym::SymmetrySpec& spec) {
+  const bool next_turn = params.flag("observe_next_turn", false);
+  const int extra = kBallObs + (next_turn ? kNextTurnObs : 0);
+  const int has = spec.obsCentralDim() - HumanoidTask::kTorsoObs - 3 * spec.actCentralDim();
+  if (has != extra && (has == kBallObs || has == kBallObs + kNextTurnObs))
+    throw ConfigError(params.origin("observe_next_turn"), "env.observe_next_turn",
+                      std::string(next_turn ? "true" : "false") + " needs " + std::to_string(extra) +
+                          " central entries after the abdomen's (the ball's" +
+                          (next_turn ? " and the next turn's" : "") + "), but " + spec.source() + " has " +
+                          std::to_string(has) + "; set spec: " +
+                          (next_turn ? "configs/specs/humanoid_dribbling_next_turn.yaml"
+                                     : "\"\" (the task's own, configs/specs/humanoid_dribbling.yaml)") +
+                          " (or use the recipe humanoid_dribbling_next_turn)");
+  return extra;
 }
+}  // namespace
 
 HumanoidDribbling::HumanoidDribbling(std::shared_ptr<const MujocoModel> model, const sym::SymmetrySpec& spec,
                                      EnvParams& params)
@@ -25,7 +46,7 @@ HumanoidDribbling::HumanoidDribbling(std::shared_ptr<const MujocoModel> model, c
                     {"action", -0.01},
                     {"energy", -0.05},
                     {"lateral", -0.5}},
-                   /*start_hip_x_default=*/0.0, /*extra_central_obs=*/6) {
+                   /*start_hip_x_default=*/0.0, extraCentralObs(params, spec)) {
   const mjModel* m = model_->get();
   const int ball = model_->id(mjOBJ_JOINT, "ball");
   ball_qpos_ = m->jnt_qposadr[ball];
@@ -45,6 +66,7 @@ HumanoidDribbling::HumanoidDribbling(std::shared_ptr<const MujocoModel> model, c
   if (anchor != "torso" && anchor != "ball")
     throw ConfigError(params.origin("route_anchor"), "env.route_anchor", "must be torso or ball, got '" + anchor + "'");
   anchor_ball_ = anchor == "ball";
+  observe_next_turn_ = params.flag("observe_next_turn", false);
   segment_min_ = params.positive("segment_length_min", 4.0);
   segment_max_ = params.positive("segment_length_max", 8.0);
   turn_min_ = params.number("turn_min_deg", 30.0) * kDeg;
@@ -108,6 +130,17 @@ void HumanoidDribbling::writeObservation(float* out) const {
   ball[3] = static_cast<float>(loc[0]);
   ball[4] = static_cast<float>(loc[1]);
   ball[5] = static_cast<float>(v[2]);
+  if (observe_next_turn_) {
+    // How far ahead of the torso the segment ends (clipped: the last never ends) and where the next
+    // one heads, relative to this one (straight on after the last).
+    const bool last = current_ + 1 == numSegments();
+    const double ahead = length_[current_] - (std::cos(f.heading) * (t[0] - f.x) + std::sin(f.heading) * (t[1] - f.y));
+    const double turn = last ? 0.0 : route_[current_ + 1].heading - f.heading;
+    float* next = ball + kBallObs;
+    next[0] = static_cast<float>(std::clamp(ahead, -segment_max_, segment_max_));
+    next[1] = static_cast<float>(std::cos(turn));
+    next[2] = static_cast<float>(std::sin(turn));
+  }
   writeLimbs(out + spec().obsCentralDim());
 }
 

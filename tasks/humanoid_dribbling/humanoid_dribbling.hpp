@@ -51,6 +51,10 @@ class HumanoidDribbling final : public HumanoidTask {
   // "along the route", on to the next segment. The torso (the default) lets the ball, ahead of it,
   // roll past the turn while its speed along the old heading still pays; the ball turns them with it.
   bool anchor_ball_ = false;
+  // Issue #31 (the turns): three more central observations, the distance from the torso to the
+  // segment's end along it and the cosine and sine of the next turn, so that the policy can steer the
+  // ball before the turn rather than chase it after (needs configs/specs/humanoid_dribbling_next_turn.yaml).
+  bool observe_next_turn_ = false;
   double segment_min_, segment_max_, turn_min_, turn_max_;
   std::vector<PlanarFrame> route_;
   std::vector<double> length_;

@@ -467,5 +467,115 @@ TEST(HumanoidDribblingTask, TheKickOptionsCapTheBallSpeedRewardAndSquareTheLater
   }
 }
 
+// Issue #31 (the turns): env.observe_next_turn adds how far the segment runs on ahead of the torso
+// and where the next one heads, with its own spec (83 observations); the paper's 80 stay the default.
+const std::string kNextTurnSpec = "humanoid_dribbling_next_turn";
+
+TaskFactory nextTurnFactory(int route_segments = 32) {
+  return envFactory(kDribblingTask, editedEnv(kDribblingTask, [&](YAML::Node& env) {
+                      env["reset_noise"] = 0.0;
+                      env["observe_next_turn"] = true;
+                      env["route_segments"] = route_segments;
+                    }),
+                    shippedSpec(kNextTurnSpec));
+}
+
+TEST(HumanoidDribblingTask, WithTheNextTurnObservedThePolicySeesHowFarAheadAndWhichWay) {
+  auto t = nextTurnFactory(2).create();  // segment 1 is the last: it never ends
+  HumanoidDribbling& d = dribbling(t);
+  ASSERT_EQ(t->spec().obsDim(), 83);
+  Rng rng(3);
+  t->reset(rng);
+  const double l0 = d.segmentLength(0), turn = d.segmentFrame(1).heading;
+  ASSERT_GT(std::abs(turn), 29.0 * M_PI / 180.0);
+  t->data()->qpos[0] = l0 - 2.5;  // segment 0 runs along +x from the origin
+  t->data()->qpos[1] = 0.3;       // off its line: the distance ahead is along it
+  mj_forward(t->model(), t->data());
+  std::vector<float> o = observation(*t);
+  EXPECT_NEAR(o[obsIndex(*t, "central.next_turn_ahead")], 2.5, 1e-5);
+  EXPECT_NEAR(o[obsIndex(*t, "central.next_turn_cos")], std::cos(turn), 1e-6);
+  EXPECT_NEAR(o[obsIndex(*t, "central.next_turn_sin")], std::sin(turn), 1e-6);
+  EXPECT_EQ(obsIndex(*t, "central.next_turn_ahead"), obsIndex(*t, "central.ball_lin_vel[2]") + 1);
+
+  // On the last segment: no turn ahead, straight on, the distance clipped to the longest segment.
+  const PlanarFrame s1 = d.segmentFrame(1);
+  t->data()->qpos[0] = s1.x + 0.1 * std::cos(s1.heading);
+  t->data()->qpos[1] = s1.y + 0.1 * std::sin(s1.heading);
+  double* b = ballQpos(*t);
+  b[0] = s1.x + 0.7 * std::cos(s1.heading);
+  b[1] = s1.y + 0.7 * std::sin(s1.heading);
+  mj_forward(t->model(), t->data());
+  stepZero(*t);
+  ASSERT_EQ(d.currentSegment(), 1);
+  o = observation(*t);
+  EXPECT_EQ(o[obsIndex(*t, "central.next_turn_ahead")], 8.0f);  // segment_length_max
+  EXPECT_EQ(o[obsIndex(*t, "central.next_turn_cos")], 1.0f);
+  EXPECT_EQ(o[obsIndex(*t, "central.next_turn_sin")], 0.0f);
+}
+
+TEST(HumanoidDribblingTask, NextTurnOptionAndSpecThatDisagreeAreRefusedNamingTheWayOut) {
+  const auto refused = [](bool option, const std::string& spec) {
+    try {
+      envFactory(kDribblingTask, editedEnv(kDribblingTask, [&](YAML::Node& env) { env["observe_next_turn"] = option; }),
+                 shippedSpec(spec))
+          .create();
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string without_spec = refused(true, kDribblingTask);
+  EXPECT_NE(without_spec.find("env.observe_next_turn"), std::string::npos) << without_spec;
+  EXPECT_NE(without_spec.find("configs/specs/humanoid_dribbling_next_turn.yaml"), std::string::npos) << without_spec;
+  const std::string without_option = refused(false, kNextTurnSpec);
+  EXPECT_NE(without_option.find("env.observe_next_turn"), std::string::npos) << without_option;
+  EXPECT_NE(without_option.find("has 9"), std::string::npos) << without_option;
+}
+
+TEST(HumanoidDribblingTask, PhysicsSymmetryVerifierPassesWithTheNextTurnObserved) {
+  const SymmetryReport r = verifySymmetry(nextTurnFactory(), {.num_states = 20, .steps = 3, .tolerance = kTolerance});
+  EXPECT_TRUE(r.passed()) << r.summary();
+}
+
+// The turn's sine flips with the mirrored route: declared invariant, the verifier names it (and only it).
+TEST(HumanoidDribblingTask, NextTurnSineDeclaredInvariantFailsTheObservationMapNamingIt) {
+  const sym::SymmetrySpec broken = editedSpec(kNextTurnSpec, [](YAML::Node& root) {
+    for (YAML::Node e : root["observation"]["central"])
+      if (e["name"].as<std::string>() == "next_turn_sin") e["kind"] = "invariant";
+  });
+  const SymmetryReport r = verifySymmetry(
+      envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) { env["observe_next_turn"] = true; }), broken),
+      {.num_states = 5, .tolerance = kTolerance});
+  EXPECT_FALSE(r.passed());
+  for (const auto& e : r.observation_map) {
+    if (e.name == "central.next_turn_sin") {
+      EXPECT_GT(e.error, 0.4) << e.name;  // sin of a 30-90 degree turn, of either sign
+    } else {
+      EXPECT_EQ(e.error, 0.0) << e.name;
+    }
+  }
+}
+
+// Past a turn, with the option and the ball as anchor (the recipe's setting), the mirror still commutes.
+TEST(HumanoidDribblingTask, SymmetryHoldsWithTheNextTurnObservedAsTheBallPassesATurn) {
+  TaskFactory f = envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) {
+                               env["observe_next_turn"] = true;
+                               env["route_anchor"] = "ball";
+                             }),
+                             shippedSpec(kNextTurnSpec));
+  auto t = f.create();
+  HumanoidDribbling& d = dribbling(t);
+  Rng rng(11);
+  t->reset(rng);
+  const double l0 = d.segmentLength(0);
+  t->data()->qpos[0] = l0 - 0.6;
+  ballQpos(*t)[0] = l0 - 0.02;
+  ballQvel(*t)[0] = 1.5;
+  mj_forward(t->model(), t->data());
+  expectMirrorCommutes(mirrorMismatch(f, *t, 5, rng));
+  stepZero(*t);
+  EXPECT_EQ(d.currentSegment(), 1);
+}
+
 }  // namespace
 }  // namespace masa::task
