@@ -1,15 +1,14 @@
 #!/usr/bin/env python3
 """Two forks of one run side by side, window by window after the fork point (standard library only).
 
-  windows.py FORK_POINT WIDTH LABEL=metrics.csv LABEL=metrics.csv ...
+  windows.py [--csv OUT.csv] FORK_POINT WIDTH LABEL=metrics.csv LABEL=metrics.csv ...
 
 For each window of WIDTH updates after FORK_POINT: every run's mean training episode length and
 return, and the mean of its evaluations in the window (the policy mean's route_m and length, where
-the run evaluated). Only updates every run reached are compared. Writes windows.csv beside it too,
-for windows.gp to draw.
+the run evaluated). Only updates every run reached are compared. --csv writes the table for a plot
+(windows.gp draws windows.csv).
 """
 import csv
-import os
 import sys
 
 
@@ -24,10 +23,14 @@ def mean(rows, key):
 
 
 def main():
-    if len(sys.argv) < 4:
+    args = sys.argv[1:]
+    csv_out = None
+    if args[:1] == ["--csv"] and len(args) > 1:
+        csv_out, args = args[1], args[2:]
+    if len(args) < 3:
         sys.exit(__doc__)
-    fork, width = int(sys.argv[1]), int(sys.argv[2])
-    runs = [(a.split("=", 1)[0], load(a.split("=", 1)[1])) for a in sys.argv[3:]]
+    fork, width = int(args[0]), int(args[1])
+    runs = [(a.split("=", 1)[0], load(a.split("=", 1)[1])) for a in args[2:]]
     last = min(max(r) for _, r in runs)
     cols = ["length", "return", "eval_route_m", "eval_length"]
     out = []
@@ -45,10 +48,11 @@ def main():
         print(line)
         out.append(row)
         lo += width
-    with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "windows.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(out[0]) if out else ["first", "last"])
-        w.writeheader()
-        w.writerows(out)
+    if csv_out:
+        with open(csv_out, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(out[0]) if out else ["first", "last"])
+            w.writeheader()
+            w.writerows(out)
 
 
 if __name__ == "__main__":
