@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Builds masa_train and masa_compare of one commit into a directory of their own: the frozen
-# binaries a grid keeps using while the checkout moves on (MASA_BUILD_DIR=BUILD_DIR experiments/grid.sh
-# ...), and the way to get them back on a new machine for a grid restored from its record.
+# Builds masa_train, masa_compare and masa_eval of one commit into a directory of their own: the
+# frozen binaries a grid keeps using while the checkout moves on (MASA_BUILD_DIR=BUILD_DIR
+# experiments/grid.sh ...; film_grid.sh and ship_policy.sh evaluate with its masa_eval), and the way
+# to get them back on a new machine for a grid restored from its record.
 #
 #   experiments/build_at.sh COMMIT BUILD_DIR
 #
@@ -9,7 +10,7 @@
 # machine's CPU (-march=native), no tests or benchmarks. Run again, it only rebuilds what changed.
 set -euo pipefail
 
-[ $# -eq 2 ] || { sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+[ $# -eq 2 ] || { sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 commit=$1 dir=$2
 repo=$(cd "$(dirname "$0")/.." && pwd)
 full=$(git -C "$repo" rev-parse --verify --quiet "$commit^{commit}") || {
@@ -26,6 +27,11 @@ else
 fi
 cmake -S "$src" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DMASA_BUILD_TESTS=OFF -DMASA_BUILD_BENCHMARKS=OFF > "$dir.cmake.log" ||
   { tail -n 20 "$dir.cmake.log" >&2; exit 1; }
-cmake --build "$dir" -j"$(nproc)" --target masa_train masa_compare > "$dir.build.log" 2>&1 ||
+targets="masa_train masa_compare"
+# masa_eval where the commit has it (a commit older than the tool builds without it).
+# (The list is read whole first: grep -q leaving early would fail the pipe under pipefail.)
+known=$(cmake --build "$dir" --target help 2> /dev/null || true)
+grep -qw masa_eval <<< "$known" && targets="$targets masa_eval"
+cmake --build "$dir" -j"$(nproc)" --target $targets > "$dir.build.log" 2>&1 ||
   { tail -n 20 "$dir.build.log" >&2; exit 1; }
-echo "build_at.sh: masa_train and masa_compare of ${full:0:12} in $dir (use MASA_BUILD_DIR=$dir)"
+echo "build_at.sh: ${targets// /, } of ${full:0:12} in $dir (use MASA_BUILD_DIR=$dir)"
