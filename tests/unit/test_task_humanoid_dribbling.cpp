@@ -359,9 +359,9 @@ TEST(HumanoidDribblingTask, WithTheBallAsAnchorTheBallPassingTheTurnReanchors) {
   }
 }
 
-// The mirror maps the ball's passing of a turn onto the mirrored ball passing the mirrored turn.
-TEST(HumanoidDribblingTask, SymmetryHoldsWithTheBallAsAnchorAtATurn) {
-  TaskFactory f = envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) { env["route_anchor"] = "ball"; }));
+// The mirror maps the ball's passing of a turn onto the mirrored ball passing the mirrored turn
+// (with env.route_anchor: ball in f's env, the passing moves the frame on).
+void expectMirrorCommutesAsTheBallPassesATurn(const TaskFactory& f) {
   auto t = f.create();
   HumanoidDribbling& d = dribbling(t);
   Rng rng(11);
@@ -374,6 +374,11 @@ TEST(HumanoidDribblingTask, SymmetryHoldsWithTheBallAsAnchorAtATurn) {
   expectMirrorCommutes(mirrorMismatch(f, *t, 5, rng));
   stepZero(*t);
   EXPECT_EQ(d.currentSegment(), 1);
+}
+
+TEST(HumanoidDribblingTask, SymmetryHoldsWithTheBallAsAnchorAtATurn) {
+  expectMirrorCommutesAsTheBallPassesATurn(
+      envFactory(kDribblingTask, editedEnv(kDribblingTask, [](YAML::Node& env) { env["route_anchor"] = "ball"; })));
 }
 
 TEST(HumanoidDribblingTask, SymmetryHoldsPastATurnWithTheRouteMirrored) {
@@ -563,18 +568,7 @@ TEST(HumanoidDribblingTask, SymmetryHoldsWithTheNextTurnObservedAsTheBallPassesA
                                env["route_anchor"] = "ball";
                              }),
                              shippedSpec(kNextTurnSpec));
-  auto t = f.create();
-  HumanoidDribbling& d = dribbling(t);
-  Rng rng(11);
-  t->reset(rng);
-  const double l0 = d.segmentLength(0);
-  t->data()->qpos[0] = l0 - 0.6;
-  ballQpos(*t)[0] = l0 - 0.02;
-  ballQvel(*t)[0] = 1.5;
-  mj_forward(t->model(), t->data());
-  expectMirrorCommutes(mirrorMismatch(f, *t, 5, rng));
-  stepZero(*t);
-  EXPECT_EQ(d.currentSegment(), 1);
+  expectMirrorCommutesAsTheBallPassesATurn(f);
 }
 
 }  // namespace
