@@ -17,6 +17,11 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr int kBallObs = 6;      // the ball's position and velocity
 constexpr int kNextTurnObs = 3;  // env.observe_next_turn: the turn's distance ahead, the next heading
 
+// How far the point p (world x, y) is along segment frame f, from its start.
+double alongSegment(const PlanarFrame& f, const double* p) {
+  return std::cos(f.heading) * (p[0] - f.x) + std::sin(f.heading) * (p[1] - f.y);
+}
+
 // Read before the humanoid body checks the spec's layout, which depends on it: a spec without the
 // next turn's entries (or with them, and the option off) is named here with the way out.
 int extraCentralObs(EnvParams& params, const sym::SymmetrySpec& spec) {
@@ -134,7 +139,7 @@ void HumanoidDribbling::writeObservation(float* out) const {
     // How far ahead of the torso the segment ends (clipped: the last never ends) and where the next
     // one heads, relative to this one (straight on after the last).
     const bool last = current_ + 1 == numSegments();
-    const double ahead = length_[current_] - (std::cos(f.heading) * (t[0] - f.x) + std::sin(f.heading) * (t[1] - f.y));
+    const double ahead = length_[current_] - alongSegment(f, t);
     const double turn = last ? 0.0 : route_[current_ + 1].heading - f.heading;
     float* next = ball + kBallObs;
     next[0] = static_cast<float>(std::clamp(ahead, -segment_max_, segment_max_));
@@ -168,8 +173,7 @@ void HumanoidDribbling::afterStep() {
   const double* p = anchor_ball_ ? ballPos() : torsoPos();
   while (current_ + 1 < numSegments()) {
     const PlanarFrame& f = route_[current_];
-    const double along = std::cos(f.heading) * (p[0] - f.x) + std::sin(f.heading) * (p[1] - f.y);
-    if (along < length_[current_]) break;
+    if (alongSegment(f, p) < length_[current_]) break;
     ++current_;
   }
 }
@@ -179,7 +183,7 @@ void HumanoidDribbling::progress(double* out) const {
   for (int k = 0; k < current_; ++k) passed += length_[k];
   const PlanarFrame& f = route_[current_];
   const double* b = ballPos();
-  const double along = std::cos(f.heading) * (b[0] - f.x) + std::sin(f.heading) * (b[1] - f.y);
+  const double along = alongSegment(f, b);
   const double t = episode().length * controlTimestep();
   out[0] = passed + along;
   out[1] = current_;
