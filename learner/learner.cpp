@@ -530,10 +530,11 @@ const integrity::FileKind kOffPolicyStateKind{"masa off-policy learner state", "
 }
 
 void Learner::writeOffPolicyState() {
-  std::ostringstream os;
-  io::writePod(os, updates_);
-  off_policy_->save(os);
-  integrity::writeSealedFile((fs::path(dir_) / "off_policy_state.bin").string(), kOffPolicyStateKind, os.str());
+  // Streamed: the replay (most of a gigabyte) goes to the disk as it is hashed, never copied whole.
+  integrity::writeSealedFileStreamed((fs::path(dir_) / "off_policy_state.bin").string(), kOffPolicyStateKind, [&](std::ostream& os) {
+    io::writePod(os, updates_);
+    off_policy_->save(os);
+  });
 }
 
 void Learner::appendOffPolicyRow(double lag_mean, int64_t lag_max) {

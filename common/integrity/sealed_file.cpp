@@ -9,7 +9,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <stdexcept>
+#include <streambuf>
+#include <vector>
 
 #include "common/integrity/sha256.hpp"
 
@@ -109,13 +112,19 @@ std::string readWholeFile(const std::string& path) {
   return bytes;
 }
 
-// Temporary file, flushed to the disk, renamed over `path`: a reader sees the old file or the new
-// one, never half of one, even after a crash.
-void writeAtomically(const std::string& path, std::string_view bytes) {
-  const std::string tmp = path + ".tmp";
+// The temporary file beside `path` that becomes it once whole.
+std::string temporaryFor(const std::string& path) { return path + ".tmp"; }
+
+std::FILE* openTemporary(const std::string& tmp) {
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) refuse(tmp, std::string("cannot write (") + std::strerror(errno) + ")");
-  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
+  return f;
+}
+
+// Flushed to the disk, closed and renamed over `path`: a reader sees the old file or the new one,
+// never half of one, even after a crash. `ok` false (a write failed) removes the temporary instead.
+void publishTemporary(std::FILE* f, const std::string& tmp, const std::string& path, bool ok) {
+  ok = ok && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
   if (std::fclose(f) != 0 || !ok) {
     std::remove(tmp.c_str());
     refuse(tmp, "write failed");
@@ -124,6 +133,69 @@ void writeAtomically(const std::string& path, std::string_view bytes) {
   std::filesystem::rename(tmp, path, ec);
   if (ec) refuse(path, "cannot rename " + tmp + " to it (" + ec.message() + ")");
 }
+
+void writeAtomically(const std::string& path, std::string_view bytes) {
+  const std::string tmp = temporaryFor(path);
+  std::FILE* f = openTemporary(tmp);
+  publishTemporary(f, tmp, path, std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size());
+}
+
+// A sealed file's body on its way to the disk: each byte is hashed and written as it comes, through
+// one buffer of its own, so the payload is never whole in memory.
+class HashingFileBuf final : public std::streambuf {
+ public:
+  explicit HashingFileBuf(std::FILE* f) : f_(f), buf_(kBufferBytes) { resetBuffer(); }
+
+  std::uint64_t bytes() const { return emitted_ + static_cast<std::uint64_t>(pptr() - pbase()); }
+  bool failed() const { return failed_; }
+  // Writes out what is buffered; false once the disk refused a byte.
+  bool drain() {
+    emit(pbase(), pptr() - pbase());
+    resetBuffer();
+    return !failed_;
+  }
+  Digest digest() { return sha_.finish(); }
+
+ protected:
+  int_type overflow(int_type ch) override {
+    if (!drain()) return traits_type::eof();
+    if (!traits_type::eq_int_type(ch, traits_type::eof())) {
+      *pptr() = traits_type::to_char_type(ch);
+      pbump(1);
+    }
+    return traits_type::not_eof(ch);
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    if (n > epptr() - pptr()) {
+      if (!drain()) return 0;
+      if (n > epptr() - pptr()) {  // larger than the buffer: straight to the disk, no copy
+        emit(s, n);
+        return failed_ ? 0 : n;
+      }
+    }
+    std::memcpy(pptr(), s, static_cast<std::size_t>(n));
+    pbump(static_cast<int>(n));
+    return n;
+  }
+  int sync() override { return drain() ? 0 : -1; }
+
+ private:
+  static constexpr std::size_t kBufferBytes = std::size_t{1} << 20;
+
+  void resetBuffer() { setp(buf_.data(), buf_.data() + buf_.size()); }
+  void emit(const char* p, std::streamsize n) {
+    if (n <= 0 || failed_) return;
+    sha_.update(p, static_cast<std::size_t>(n));
+    emitted_ += static_cast<std::uint64_t>(n);
+    failed_ = std::fwrite(p, 1, static_cast<std::size_t>(n), f_) != static_cast<std::size_t>(n);
+  }
+
+  std::FILE* f_;
+  std::vector<char> buf_;
+  Sha256 sha_;
+  std::uint64_t emitted_ = 0;
+  bool failed_ = false;
+};
 
 }  // namespace
 
@@ -150,7 +222,37 @@ std::string sealBytes(const FileKind& kind, std::string_view payload) {
 }
 
 void writeSealedFile(const std::string& path, const FileKind& kind, std::string_view payload) {
-  writeAtomically(path, sealBytes(kind, payload));
+  writeSealedFileStreamed(path, kind, [&](std::ostream& os) { os.write(payload.data(), static_cast<std::streamsize>(payload.size())); });
+}
+
+void writeSealedFileStreamed(const std::string& path, const FileKind& kind, const std::function<void(std::ostream&)>& write_payload) {
+  const std::string tmp = temporaryFor(path);
+  std::FILE* f = openTemporary(tmp);
+  bool ok = false;
+  try {
+    // The header's length and checksum are known only at the end: room for it now, filled in then.
+    const char room[kHeaderBytes] = {};
+    ok = std::fwrite(room, 1, kHeaderBytes, f) == kHeaderBytes;
+    HashingFileBuf body(f);
+    std::ostream os(&body);
+    const auto kind_bytes = static_cast<std::uint32_t>(kind.name.size());
+    os.write(reinterpret_cast<const char*>(&kind_bytes), sizeof kind_bytes);
+    os.write(kind.name.data(), static_cast<std::streamsize>(kind.name.size()));
+    write_payload(os);
+    ok = ok && os.good() && body.drain();
+    std::string header;
+    header.append(kSealMagic);
+    appendPod(header, kEnvelopeVersion);
+    appendPod(header, body.bytes());
+    const Digest d = body.digest();
+    header.append(reinterpret_cast<const char*>(d.data()), d.size());
+    ok = ok && std::fseek(f, 0, SEEK_SET) == 0 && std::fwrite(header.data(), 1, header.size(), f) == header.size();
+  } catch (...) {
+    std::fclose(f);
+    std::remove(tmp.c_str());
+    throw;
+  }
+  publishTemporary(f, tmp, path, ok);
 }
 
 OpenedFile openSealedBytes(std::string bytes, const std::string& name, const FileKind& kind, const ReadRules& rules) {

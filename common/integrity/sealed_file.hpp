@@ -17,6 +17,8 @@
 // payload.
 #pragma once
 
+#include <functional>
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -47,6 +49,11 @@ struct OpenedFile {
 std::string sealBytes(const FileKind& kind, std::string_view payload);
 // Writes the sealed payload to `path` atomically (a temporary file beside it, flushed, renamed).
 void writeSealedFile(const std::string& path, const FileKind& kind, std::string_view payload);
+// The same file, its payload produced by `write_payload` into the stream it is given: the bytes are
+// hashed and go to the disk as they come, never held whole in memory (a learner's replay is most of
+// a gigabyte, and copying it cost more than writing it). If write_payload throws, or the disk
+// refuses a byte, the old file at `path` stays as it was and the error goes on.
+void writeSealedFileStreamed(const std::string& path, const FileKind& kind, const std::function<void(std::ostream&)>& write_payload);
 
 // Checks a sealed file's bytes (`name` says where they came from) and returns its payload; throws
 // std::runtime_error "<name>: <reason>" when the file is not intact, not of `kind`, or not signed as

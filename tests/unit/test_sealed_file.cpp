@@ -10,7 +10,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "common/integrity/ed25519_keys.hpp"
@@ -70,6 +72,54 @@ TEST(SealedFile, APayloadRoundTripsThroughAFileWrittenAtomically) {
   EXPECT_TRUE(looksLikeKind((dir / "toy.bin").string(), kToyKind));
   EXPECT_FALSE(looksLikeKind((dir / "toy.bin").string(), kOtherKind));
   EXPECT_EQ(sealedKindOf((dir / "toy.bin").string()), "masa toy");
+}
+
+// A payload written piece by piece (a character, small writes, one write larger than the writer's
+// buffer) gives the very bytes the envelope built in memory gives, at sizes about the buffer's.
+TEST(SealedFile, AStreamedWriteGivesTheSameBytesAsTheEnvelopeBuiltInMemory) {
+  const fs::path dir = sealedDir("streamed");
+  const std::size_t mib = std::size_t{1} << 20;
+  for (const std::size_t n : {std::size_t{0}, std::size_t{1}, mib - 8, mib + 1, 3 * mib + 17}) {
+    const std::string payload = toyPayload(n).substr(0, n);
+    const std::string path = (dir / ("toy" + std::to_string(n) + ".bin")).string();
+    writeSealedFileStreamed(path, kToyKind, [&](std::ostream& os) {
+      std::size_t at = 0;
+      if (n > 0) os.put(payload[at++]);
+      for (int i = 0; i < 100 && at + 777 <= n; ++i, at += 777) os.write(payload.data() + at, 777);
+      os.write(payload.data() + at, static_cast<std::streamsize>(n - at));
+    });
+    EXPECT_EQ(sealedBytes(path), sealBytes(kToyKind, payload)) << n << " bytes";
+    EXPECT_FALSE(fs::exists(path + ".tmp"));
+  }
+}
+
+TEST(SealedFile, AStreamedWriteThatThrowsLeavesTheOldFileAndNoTemporary) {
+  const fs::path dir = sealedDir("streamed_throw");
+  const std::string path = (dir / "toy.bin").string();
+  writeSealedFile(path, kToyKind, toyPayload(500));
+  const std::string before = sealedBytes(path);
+  EXPECT_THROW(writeSealedFileStreamed(path, kToyKind,
+                                       [&](std::ostream& os) {
+                                         os << toyPayload(3 << 20);
+                                         throw std::runtime_error("the payload's writer failed");
+                                       }),
+               std::runtime_error);
+  EXPECT_EQ(sealedBytes(path), before);
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+}
+
+// A full disk: /dev/full refuses every byte, so the write fails with the reason, not silently.
+TEST(SealedFile, AStreamedWriteTheDiskRefusesFailsByName) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here";
+  const fs::path dir = sealedDir("streamed_full");
+  fs::create_symlink("/dev/full", dir / "toy.bin.tmp");
+  try {
+    writeSealedFileStreamed((dir / "toy.bin").string(), kToyKind, [&](std::ostream& os) { os << toyPayload(3 << 20); });
+    ADD_FAILURE() << "a write to a full disk was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("write failed"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "toy.bin"));
 }
 
 TEST(SealedFile, EverySingleBitFlipAndEveryCutIsRefusedWithTheFileAndTheReason) {
