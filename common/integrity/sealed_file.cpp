@@ -112,6 +112,25 @@ std::string readWholeFile(const std::string& path) {
   return bytes;
 }
 
+// The body's start: the kind's length and name, before the payload.
+std::string kindPrefix(const FileKind& kind) {
+  std::string out;
+  appendPod(out, static_cast<std::uint32_t>(kind.name.size()));
+  out.append(kind.name);
+  return out;
+}
+
+// The seal's header for a body of `body_bytes` bytes whose SHA-256 is `digest`.
+std::string sealHeader(std::uint64_t body_bytes, const Digest& digest) {
+  std::string out;
+  out.reserve(kHeaderBytes);
+  out.append(kSealMagic);
+  appendPod(out, kEnvelopeVersion);
+  appendPod(out, body_bytes);
+  out.append(reinterpret_cast<const char*>(digest.data()), digest.size());
+  return out;
+}
+
 // The temporary file beside `path` that becomes it once whole.
 std::string temporaryFor(const std::string& path) { return path + ".tmp"; }
 
@@ -147,7 +166,6 @@ class HashingFileBuf final : public std::streambuf {
   explicit HashingFileBuf(std::FILE* f) : f_(f), buf_(kBufferBytes) { resetBuffer(); }
 
   std::uint64_t bytes() const { return emitted_ + static_cast<std::uint64_t>(pptr() - pbase()); }
-  bool failed() const { return failed_; }
   // Writes out what is buffered; false once the disk refused a byte.
   bool drain() {
     emit(pbase(), pptr() - pbase());
@@ -205,20 +223,9 @@ std::string OpenedFile::describe() const {
 }
 
 std::string sealBytes(const FileKind& kind, std::string_view payload) {
-  std::string body;
-  body.reserve(4 + kind.name.size() + payload.size());
-  appendPod(body, static_cast<std::uint32_t>(kind.name.size()));
-  body.append(kind.name);
+  std::string body = kindPrefix(kind);
   body.append(payload);
-  std::string out;
-  out.reserve(kHeaderBytes + body.size());
-  out.append(kSealMagic);
-  appendPod(out, kEnvelopeVersion);
-  appendPod(out, static_cast<std::uint64_t>(body.size()));
-  const Digest d = sha256(body);
-  out.append(reinterpret_cast<const char*>(d.data()), d.size());
-  out.append(body);
-  return out;
+  return sealHeader(body.size(), sha256(body)).append(body);
 }
 
 void writeSealedFile(const std::string& path, const FileKind& kind, std::string_view payload) {
@@ -235,17 +242,11 @@ void writeSealedFileStreamed(const std::string& path, const FileKind& kind, cons
     ok = std::fwrite(room, 1, kHeaderBytes, f) == kHeaderBytes;
     HashingFileBuf body(f);
     std::ostream os(&body);
-    const auto kind_bytes = static_cast<std::uint32_t>(kind.name.size());
-    os.write(reinterpret_cast<const char*>(&kind_bytes), sizeof kind_bytes);
-    os.write(kind.name.data(), static_cast<std::streamsize>(kind.name.size()));
+    const std::string prefix = kindPrefix(kind);
+    os.write(prefix.data(), static_cast<std::streamsize>(prefix.size()));
     write_payload(os);
     ok = ok && os.good() && body.drain();
-    std::string header;
-    header.append(kSealMagic);
-    appendPod(header, kEnvelopeVersion);
-    appendPod(header, body.bytes());
-    const Digest d = body.digest();
-    header.append(reinterpret_cast<const char*>(d.data()), d.size());
+    const std::string header = sealHeader(body.bytes(), body.digest());
     ok = ok && std::fseek(f, 0, SEEK_SET) == 0 && std::fwrite(header.data(), 1, header.size(), f) == header.size();
   } catch (...) {
     std::fclose(f);
