@@ -349,7 +349,11 @@ void Learner::update() {
     lag_max = std::max(lag_max, updates_ - v);
   }
   if (off_policy_) {
-    report_.ppo = off_policy_->learn(buffer_->data(), rng_);
+    // An environment's stream: its actor and its index there (ids below 2^32 each).
+    env_streams_.resize(origin_.env_actor.size());
+    for (std::size_t e = 0; e < env_streams_.size(); ++e)
+      env_streams_[e] = (static_cast<int64_t>(origin_.env_actor[e]) << 32) | static_cast<uint32_t>(origin_.env_index[e]);
+    report_.ppo = off_policy_->learn(buffer_->data(), env_streams_, rng_);
     report_.algorithm_figures = offPolicyProgressFigures(off_policy_->roundFigures());
   } else {
     optimizePpo();

@@ -163,6 +163,7 @@ class Learner {
   std::unique_ptr<ppo::RolloutBuffer> buffer_;
   std::unique_ptr<OffPolicyLearning> off_policy_;  // learner: off_policy (then PPO's trainer idles)
   BatchOrigin origin_;  // where the batch's environments came from: their policy versions (the lag)
+  std::vector<int64_t> env_streams_;  // the off-policy learner's stream id of each batch column
 
   cluster::Communicator* ranks_;
   int rank_envs_;  // this rank's environments of a full batch

@@ -9,7 +9,9 @@
 #pragma once
 
 #include <iosfwd>
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,10 +26,12 @@ namespace masa::learner {
 class OffPolicyLearning {
  public:
   virtual ~OffPolicyLearning() = default;
-  // Takes the batch's transitions into replay and makes the gradient steps owed. The figures that
-  // have a PPO column go there (actor_loss, critic_loss: twin Q, entropy, sym_policy_loss; the
+  // Takes the batch's transitions into replay and makes the gradient steps owed. env_streams names
+  // each environment column's source (the same id for the same actor's environment every round,
+  // so that an episode's stretches are known as one; empty: every stretch its own). The figures
+  // that have a PPO column go there (actor_loss, critic_loss: twin Q, entropy, sym_policy_loss; the
   // others 0); roundFigures() has them all.
-  virtual ppo::PpoStats learn(const rollout::Rollout& batch, Rng& rng) = 0;
+  virtual ppo::PpoStats learn(const rollout::Rollout& batch, std::span<const int64_t> env_streams, Rng& rng) = 0;
   // The last learn()'s figures by name (the columns of the run's off_policy.csv): gradient steps of
   // the round and in all, replay size, the losses, alpha, mean Q.
   virtual std::vector<std::pair<std::string, double>> roundFigures() const = 0;

@@ -40,6 +40,8 @@ SacConfig readSacConfig(const config::RunConfig& rc) {
   c.td3_policy_noise = r.nonNegative("td3_policy_noise");
   c.td3_noise_clip = r.nonNegative("td3_noise_clip");
   c.td3_policy_delay = r.atLeast("td3_policy_delay", 1);
+  c.her_share = r.inRange("her_share", 0.0, 1.0);
+  c.her_future_window = r.atLeast("her_future_window", 0LL);
   return c;
 }
 

@@ -36,6 +36,11 @@ struct SacConfig {
   double td3_policy_noise = 0.2;       // std of the target policy smoothing noise
   double td3_noise_clip = 0.5;         // the smoothing noise clipped to +-this
   int td3_policy_delay = 2;            // critic steps per actor step (and target move)
+  // Hindsight relabeling (learner/sac/hindsight.hpp): the share of each batch whose goal becomes one
+  // achieved later in the same episode ("future"), drawn among the next her_future_window steps
+  // (0: to the episode's newest stored step). HER's k relabeled goals per real one is k/(k+1).
+  double her_share = 0.0;
+  long long her_future_window = 0;
 };
 
 // Reads rc.resolved["sac"] (config::sectionOf); throws masa::ConfigError naming the key path

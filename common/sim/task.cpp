@@ -57,6 +57,13 @@ Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::Symm
 
 Task::~Task() { mj_deleteData(data_); }
 
+double Task::termWeight(const std::string& term) const {
+  for (std::size_t k = 0; k < weights_.size(); ++k)
+    if (term_names_[k] == term) return weights_[k];
+  MASA_CHECK(false, name_ << " has no reward term '" << term << "'");
+  return 0.0;
+}
+
 namespace {
 
 // The actuator a spec names: an actuator of that name, else the one actuator driving the joint of

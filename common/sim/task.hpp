@@ -21,6 +21,7 @@
 #include "common/core/types.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/sim/env_params.hpp"
+#include "common/sim/goal_relabeling.hpp"
 #include "common/sim/mujoco_model.hpp"
 
 namespace masa::task {
@@ -84,6 +85,9 @@ class Task {
   // tasks that only score (the walkers) have no success to report or plot.
   bool measuresSuccess() const { return hasSuccessMeasure(); }
   virtual void progress(double* out) const {}
+  // A goal-conditioned task's relabeling (common/sim/goal_relabeling.hpp), with this instance's
+  // reward weights and tolerances; null for a task that declares no goal (the default).
+  virtual std::unique_ptr<GoalRelabeling> goalRelabeling() const { return nullptr; }
 
   // Whole-state symmetry: the state becomes T_i of itself (then mj_forward). The verifier compares
   // step(T s, T a) with T step(s, a).
@@ -169,6 +173,9 @@ class Task {
 
   // --- helpers for tasks ---
   int frameSkip() const { return frame_skip_; }
+  // The weight env.weights.<term> of one of the task's reward terms; the termination reward.
+  double termWeight(const std::string& term) const;
+  double terminationReward() const { return termination_reward_; }
   // The paper's "joints power consumption" in the convention its weights were tuned for
   // (IsaacGym's electricity cost): sum over actions of |a_k * qdot_k| * energy_velocity_scale * w_k,
   // with a_k the clamped action in [-1, 1], qdot_k its joint's velocity (rad/s), and w_k = 1 (the

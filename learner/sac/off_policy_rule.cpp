@@ -2,21 +2,35 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <istream>
 #include <ostream>
 #include <stdexcept>
 
 #include "common/core/binary_io.hpp"
+#include "common/core/check.hpp"
 #include "common/model/method.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_policy_file.hpp"
 #include "learner/sac/trainer_factory.hpp"
+#include "tasks/tasks.hpp"
 
 namespace masa::sac {
 namespace {
-constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'O', 'F', 'F', '1'};
+// Version 2 adds the streams' episodes; a version 1 state resumes with every stream's next
+// stretch a new episode.
+constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'O', 'F', 'F', '2'};
+constexpr char kMagicV1[8] = {'M', 'A', 'S', 'A', 'O', 'F', 'F', '1'};
+
+// The task's goal relabeling, built only when it is asked for (a task instance loads its model).
+std::unique_ptr<task::GoalRelabeling> goalRelabelingOf(const config::RunConfig& rc, const SacConfig& sc,
+                                                       const sym::SymmetrySpec& spec) {
+  if (!(sc.her_share > 0.0)) return nullptr;
+  return task::TaskFactory(task::taskCatalog(), rc.task, spec, rc.env, rc.origin).create()->goalRelabeling();
 }
+}  // namespace
 
 OffPolicyRule::OffPolicyRule(const config::RunConfig& rc, Rng& rng)
     : rc_(rc),
@@ -30,6 +44,7 @@ OffPolicyRule::OffPolicyRule(const config::RunConfig& rc, Rng& rng)
   q_.initialize(rng);
   q_target_.moveTowards(q_, 1.0f);
   trainer_ = makeTrainer(sc_, spec_, policy_, q_, q_target_);
+  hindsight_ = std::make_unique<Hindsight>(rc, sc_, goalRelabelingOf(rc, sc_, spec_), spec_);
 }
 
 OffPolicyRule::~OffPolicyRule() = default;
@@ -38,19 +53,32 @@ std::unique_ptr<learner::OffPolicyLearning> makeOffPolicyRule(const config::RunC
   return std::make_unique<OffPolicyRule>(rc, rng);
 }
 
-ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, Rng& rng) {
+ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, std::span<const int64_t> env_streams, Rng& rng) {
   const int E = b.num_envs, T = b.horizon;
+  MASA_CHECK(env_streams.empty() || static_cast<int>(env_streams.size()) == E,
+             "off-policy learner: " << env_streams.size() << " stream ids for " << E << " environments");
   // Where each truncated step's pre-reset observation is (the list is in step order).
   std::vector<int> final_of(static_cast<std::size_t>(E) * T, -1);
   for (int i = 0; i < b.numFinal(); ++i) final_of[static_cast<std::size_t>(b.final_index[i])] = i;
+  const std::size_t obs_bytes = sizeof(float) * static_cast<std::size_t>(b.obs_dim);
   for (int e = 0; e < E; ++e) {
+    // The stream's episode goes on if this stretch starts where its last one ended.
+    StreamTail* tail = nullptr;
+    if (!env_streams.empty()) tail = &streams_[env_streams[e]];
+    const bool continues = tail && !tail->last_obs.empty() && std::memcmp(tail->last_obs.data(), b.obsAt(0, e), obs_bytes) == 0;
+    long long episode = continues ? tail->episode : next_episode_++;
     for (int t = 0; t < T; ++t) {
       const std::size_t s = b.step(t, e);
-      const bool truncated = b.truncated[s] != 0;
+      const bool truncated = b.truncated[s] != 0, terminated = b.terminated[s] != 0;
       if (truncated && final_of[s] < 0) throw std::logic_error("off-policy learner: a truncation without its observation");
       const float* next = truncated ? b.finalObs(final_of[s]) : b.obsAt(t + 1, e);
       // The stretch's last step is cut: what follows it is in the next round's batch, if anywhere.
-      replay_.add(b.obsAt(t, e), b.actionAt(t, e), b.reward[s], next, b.terminated[s] != 0, truncated || t == T - 1);
+      replay_.add(b.obsAt(t, e), b.actionAt(t, e), b.reward[s], next, terminated, truncated || t == T - 1, episode);
+      if (terminated || truncated) episode = next_episode_++;
+    }
+    if (tail) {
+      tail->episode = episode;
+      tail->last_obs.assign(b.obsAt(T, e), b.obsAt(T, e) + b.obs_dim);
     }
   }
   received_ += static_cast<long long>(E) * T;
@@ -62,11 +90,12 @@ ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, Rng& rng) {
   if (!fitted_) return out;
   SacStats sums;
   int n = 0;
+  long long relabeled = 0;
   // The gradient steps on sac.threads threads (restored after): see configs/defaults.yaml.
   const int prev_threads = omp_get_max_threads();
   omp_set_num_threads(sc_.threads);
   for (const long long owed = gradientStepsOwed(sc_, received_ - sc_.learning_starts + 1); trainer_->steps() < owed; ++n) {
-    replay_.sample(sc_.batch_size, sc_.n_step, sc_.discount, rng, batch_);
+    relabeled += hindsight_->sample(replay_, sc_.batch_size, sc_.n_step, sc_.discount, rng, batch_);
     const SacStats s = trainer_->step(batch_, rng);
     sums.q_loss += s.q_loss;
     sums.actor_loss += s.actor_loss;
@@ -78,6 +107,7 @@ ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, Rng& rng) {
   }
   omp_set_num_threads(prev_threads);
   round_steps_ = n;
+  round_relabeled_share_ = n > 0 ? static_cast<double>(relabeled) / (static_cast<double>(n) * sc_.batch_size) : 0.0;
   if (n == 0) return out;
   for (double* v : {&sums.q_loss, &sums.actor_loss, &sums.alpha_loss, &sums.symmetry_loss, &sums.alpha, &sums.mean_q,
                     &sums.entropy})
@@ -96,7 +126,7 @@ std::vector<std::pair<std::string, double>> OffPolicyRule::roundFigures() const 
   const SacStats& m = round_means_;
   const double none = std::nan("");  // a round without gradient steps (the warm-up) has no losses
   auto mean = [&](double v) { return round_steps_ > 0 ? v : none; };
-  return {{"gradient_steps", round_steps_},
+  std::vector<std::pair<std::string, double>> figures = {{"gradient_steps", round_steps_},
           {"gradient_steps_total", static_cast<double>(trainer_->steps())},
           {"replay_size", static_cast<double>(replay_.size())},
           {"warming_up", fitted_ ? 0.0 : 1.0},
@@ -107,6 +137,9 @@ std::vector<std::pair<std::string, double>> OffPolicyRule::roundFigures() const 
           {"alpha", mean(m.alpha)},
           {"mean_q", mean(m.mean_q)},
           {"entropy", mean(m.entropy)}};
+  // With hindsight relabeling: the share of the round's samples that got a goal achieved later.
+  if (hindsight_->enabled()) figures.emplace_back("relabeled_share", mean(round_relabeled_share_));
+  return figures;
 }
 
 void OffPolicyRule::fitNormalizer() {
@@ -171,12 +204,21 @@ void OffPolicyRule::save(std::ostream& os) const {
   }
   trainer_->save(os);  // the policy with its normalizer, Q, Q', the optimizers
   replay_.save(os);
+  io::writePod(os, next_episode_);
+  io::writePod(os, static_cast<long long>(streams_.size()));
+  for (const auto& [id, tail] : streams_) {
+    io::writePod(os, id);
+    io::writePod(os, tail.episode);
+    io::writePod(os, static_cast<long long>(tail.last_obs.size()));
+    os.write(reinterpret_cast<const char*>(tail.last_obs.data()), static_cast<std::streamsize>(sizeof(float) * tail.last_obs.size()));
+  }
 }
 
 void OffPolicyRule::load(std::istream& is, const std::string& source_name) {
   char magic[8] = {};
   is.read(magic, sizeof magic);
-  if (!is || std::string(magic, 8) != std::string(kMagic, 8))
+  const bool v1 = is && std::string(magic, 8) == std::string(kMagicV1, 8);
+  if (!is || (!v1 && std::string(magic, 8) != std::string(kMagic, 8)))
     throw std::runtime_error(source_name + ": not an off-policy learner state");
   int32_t fitted = 0;
   if (!io::readPod(is, received_) || !io::readPod(is, fitted) || received_ < 0 || (fitted != 0 && fitted != 1))
@@ -195,6 +237,27 @@ void OffPolicyRule::load(std::istream& is, const std::string& source_name) {
   }
   trainer_->load(is);
   replay_.load(is);
+  streams_.clear();
+  if (v1) {
+    next_episode_ = 0;
+    for (long long k = 0; k < replay_.size(); ++k) next_episode_ = std::max(next_episode_, replay_.episodeAt(k) + 1);
+  } else {
+    long long n = 0;
+    if (!io::readPod(is, next_episode_) || !io::readPod(is, n) || next_episode_ < 0 || n < 0 || n > (1 << 24))
+      throw std::runtime_error(source_name + ": corrupt off-policy learner streams");
+    for (long long k = 0; k < n; ++k) {
+      int64_t id = 0;
+      long long len = 0;
+      StreamTail tail;
+      if (!io::readPod(is, id) || !io::readPod(is, tail.episode) || !io::readPod(is, len) || len != spec_.obsDim() ||
+          tail.episode < 0 || tail.episode >= next_episode_)
+        throw std::runtime_error(source_name + ": corrupt off-policy learner stream " + std::to_string(k));
+      tail.last_obs.resize(static_cast<std::size_t>(len));
+      is.read(reinterpret_cast<char*>(tail.last_obs.data()), static_cast<std::streamsize>(sizeof(float) * len));
+      streams_[id] = std::move(tail);
+    }
+    if (!is) throw std::runtime_error(source_name + ": truncated off-policy learner state");
+  }
   if (fitted_) applyNormalizer();
 }
 

@@ -11,8 +11,13 @@
 // Warm-up: until sac.learning_starts transitions arrived the actors act uniformly at random (the
 // parameters go out without a normalizer); then the normalizer is fitted on them and fixed, as in
 // masa_sac, and the gradient steps start: floor(updates_per_step x transitions past the start).
+//
+// Episodes: a stretch continues its stream's episode when it starts from the observation the
+// stream's last stretch ended on (the same actor's environment, nothing dropped between), so that
+// hindsight relabeling (sac.her_share) draws goals from the whole episode across rounds.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -22,6 +27,7 @@
 #include "learner/off_policy_learning.hpp"
 #include "learner/offline/twin_q.hpp"
 #include "learner/sac/off_policy_trainer.hpp"
+#include "learner/sac/hindsight.hpp"
 #include "learner/sac/replay_buffer.hpp"
 
 namespace masa::sac {
@@ -32,7 +38,7 @@ class OffPolicyRule final : public learner::OffPolicyLearning {
   OffPolicyRule(const config::RunConfig& rc, Rng& rng);
   ~OffPolicyRule() override;
 
-  ppo::PpoStats learn(const rollout::Rollout& batch, Rng& rng) override;
+  ppo::PpoStats learn(const rollout::Rollout& batch, std::span<const int64_t> env_streams, Rng& rng) override;
   void fillPolicyMessage(masa::lcmt_policy_params& m) const override;
   std::unique_ptr<model::ActorCritic<float>> evaluationModel() const override;
   void savePolicyFile(const std::string& path) const override;
@@ -58,6 +64,14 @@ class OffPolicyRule final : public learner::OffPolicyLearning {
   offline::TwinQ<float> q_, q_target_;
   std::unique_ptr<OffPolicyTrainer<float>> trainer_;
   ReplayBuffer replay_;
+  std::unique_ptr<Hindsight> hindsight_;
+  // Each stream's episode and the observation its last stretch ended on; the next episode id.
+  struct StreamTail {
+    long long episode = 0;
+    std::vector<float> last_obs;
+  };
+  std::map<int64_t, StreamTail> streams_;
+  long long next_episode_ = 0;
   long long received_ = 0;  // transitions taken into replay since the run began
   bool fitted_ = false;     // the normalizer is fitted: learning has started
   // The fitted normalizer as the actors are sent it (kept: a reloaded normalizer would re-derive it).
@@ -65,6 +79,7 @@ class OffPolicyRule final : public learner::OffPolicyLearning {
   ReplayBatch<float> batch_;
   SacStats round_means_;  // of the last learn()'s gradient steps
   int round_steps_ = 0;
+  double round_relabeled_share_ = 0;
 };
 
 // For LearnerOptions::make_off_policy.

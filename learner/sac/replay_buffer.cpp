@@ -41,19 +41,58 @@ void ReplayBuffer::reserveSlots(long long slots) {
   rewards_.resize(static_cast<size_t>(n));
   terminated_.resize(static_cast<size_t>(n));
   truncated_.resize(static_cast<size_t>(n));
+  episode_.resize(static_cast<size_t>(n));
+  place_.resize(static_cast<size_t>(n));
   allocated_ = n;
 }
 
+long long ReplayBuffer::continuingEpisode() const {
+  if (size_ == 0) return 0;
+  const long long newest = slotOfAge(0);
+  return episode_[newest] + (terminated_[newest] || truncated_[newest] ? 1 : 0);
+}
+
+void ReplayBuffer::forgetSlot(long long slot) {
+  const auto it = episodes_.find(episode_[slot]);
+  MASA_CHECK(it != episodes_.end() && it->second.slots[it->second.first] == slot,
+             "replay: slot " << slot << " is not the oldest step of its episode");
+  if (++it->second.first == static_cast<long long>(it->second.slots.size())) episodes_.erase(it);
+}
+
+void ReplayBuffer::rememberSlot(long long slot) {
+  EpisodeSlots& e = episodes_[episode_[slot]];
+  place_[slot] = static_cast<long long>(e.slots.size());
+  e.slots.push_back(slot);
+}
+
+void ReplayBuffer::rebuildEpisodes() {
+  episodes_.clear();
+  for (long long age = size_ - 1; age >= 0; --age) rememberSlot(slotOfAge(age));
+}
+
+long long ReplayBuffer::futureSlot(long long slot, long long window, Rng& rng) const {
+  const EpisodeSlots& e = episodes_.at(episode_[slot]);
+  const long long at = place_[slot];
+  long long last = static_cast<long long>(e.slots.size()) - 1;
+  if (window > 0) last = std::min(last, at + window);
+  return e.slots[std::uniform_int_distribution<long long>(at, last)(rng)];
+}
+
 void ReplayBuffer::add(const float* obs, const float* action, double reward, const float* next_obs, bool terminated,
-                       bool truncated) {
+                       bool truncated, long long episode) {
+  MASA_CHECK(episode >= 0 || episode == kContinueStream, "replay: episode ids are >= 0, got " << episode);
+  if (episode == kContinueStream) episode = continuingEpisode();
   const long long k = next_;
   reserveSlots(k + 1);
+  if (size_ == capacity_) forgetSlot(k);
   std::memcpy(obs_.data() + k * obs_dim_, obs, sizeof(float) * obs_dim_);
   std::memcpy(next_obs_.data() + k * obs_dim_, next_obs, sizeof(float) * obs_dim_);
   std::memcpy(actions_.data() + k * act_dim_, action, sizeof(float) * act_dim_);
   rewards_[k] = static_cast<float>(reward);
   terminated_[k] = terminated;
   truncated_[k] = truncated;
+  episode_[k] = episode;
+  rememberSlot(k);
   next_ = (next_ + 1) % capacity_;
   size_ = std::min(size_ + 1, capacity_);
   ++added_;
@@ -65,24 +104,40 @@ long long ReplayBuffer::slotOfAge(long long age) const {
 }
 
 template <typename S>
-void ReplayBuffer::nStep(long long slot, int n_step, double discount, ReplayBatch<S>& batch, int column) const {
+void ReplayBuffer::nStep(long long slot, int n_step, double discount, ReplayBatch<S>& batch, int column,
+                         const GoalOverride* goal) const {
   // Steps after `slot` that are stored: up to the newest, never across the write position.
   const long long newer = ((next_ - 1 - slot) % capacity_ + capacity_) % capacity_;
   const long long m_max = std::min<long long>(n_step, newer + 1);
   double ret = 0, g = 1;
   long long k = slot;
+  bool terminated = false;
   for (long long j = 0; j < m_max; ++j) {
     k = (slot + j) % capacity_;
-    ret += g * rewards_[k];
+    double r = rewards_[k];
+    terminated = terminated_[k] != 0;
+    if (goal) {
+      const task::RelabeledStep step = goal->relabeling->relabel(obsAt(k), nextObsAt(k), r, terminated, goal->goal);
+      r = step.reward;
+      terminated = step.terminated;
+    }
+    ret += g * r;
     g *= discount;
-    if (terminated_[k] || truncated_[k]) break;
+    if (terminated || truncated_[k]) break;
   }
   batch.obs.col(column) = Eigen::Map<const Eigen::VectorXf>(obs_.data() + slot * obs_dim_, obs_dim_).cast<S>();
   batch.actions.col(column) = Eigen::Map<const Eigen::VectorXf>(actions_.data() + slot * act_dim_, act_dim_).cast<S>();
   batch.next_obs.col(column) = Eigen::Map<const Eigen::VectorXf>(next_obs_.data() + k * obs_dim_, obs_dim_).cast<S>();
+  if (goal) {
+    const std::vector<int>& entries = goal->relabeling->goalEntries();
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      batch.obs(entries[i], column) = static_cast<S>(goal->goal[i]);
+      batch.next_obs(entries[i], column) = static_cast<S>(goal->goal[i]);
+    }
+  }
   batch.rewards(0, column) = static_cast<S>(ret);
   // A termination (even on the time limit's step) ends the return; a time-out bootstraps.
-  batch.discount(0, column) = terminated_[k] ? S(0) : static_cast<S>(g);
+  batch.discount(0, column) = terminated ? S(0) : static_cast<S>(g);
 }
 
 template <typename S>
@@ -96,7 +151,10 @@ void ReplayBuffer::sample(int batch_size, int n_step, double discount, Rng& rng,
 }
 
 namespace {
-constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'R', 'P', 'L', '1'};
+// Version 2 adds each stored step's episode; a version 1 buffer's episodes are read as one stream's
+// (a new one after each termination or truncation).
+constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'R', 'P', 'L', '2'};
+constexpr char kMagicV1[8] = {'M', 'A', 'S', 'A', 'R', 'P', 'L', '1'};
 
 template <typename T>
 void writeVector(std::ostream& os, const std::vector<T>& v, long long count) {
@@ -119,12 +177,15 @@ void ReplayBuffer::save(std::ostream& os) const {
   writeVector(os, rewards_, size_);
   writeVector(os, terminated_, size_);
   writeVector(os, truncated_, size_);
+  writeVector(os, episode_, size_);
 }
 
 void ReplayBuffer::load(std::istream& is) {
   char magic[8] = {};
   is.read(magic, sizeof magic);
-  if (!is || std::memcmp(magic, kMagic, sizeof kMagic) != 0) throw std::runtime_error("not a masa replay buffer (bad magic)");
+  const bool v1 = is && std::memcmp(magic, kMagicV1, sizeof kMagicV1) == 0;
+  if (!is || (!v1 && std::memcmp(magic, kMagic, sizeof kMagic) != 0))
+    throw std::runtime_error("not a masa replay buffer (bad magic)");
   long long h[6];
   for (long long& v : h)
     if (!io::readPod(is, v)) throw std::runtime_error("replay buffer: truncated header");
@@ -143,14 +204,27 @@ void ReplayBuffer::load(std::istream& is) {
   readVector(is, rewards_, size_);
   readVector(is, terminated_, size_);
   readVector(is, truncated_, size_);
+  if (v1) {
+    long long episode = 0;
+    for (long long age = size_ - 1; age >= 0; --age) {
+      const long long k = slotOfAge(age);
+      episode_[k] = episode;
+      if (terminated_[k] || truncated_[k]) ++episode;
+    }
+  } else {
+    readVector(is, episode_, size_);
+  }
   if (!is) throw std::runtime_error("replay buffer: truncated contents");
+  for (long long k = 0; k < size_; ++k)
+    if (episode_[k] < 0) throw std::runtime_error("replay buffer: corrupt episode id at slot " + std::to_string(k));
+  rebuildEpisodes();
 }
 
 template struct ReplayBatch<float>;
 template struct ReplayBatch<double>;
 template void ReplayBuffer::sample<float>(int, int, double, Rng&, ReplayBatch<float>&) const;
 template void ReplayBuffer::sample<double>(int, int, double, Rng&, ReplayBatch<double>&) const;
-template void ReplayBuffer::nStep<float>(long long, int, double, ReplayBatch<float>&, int) const;
-template void ReplayBuffer::nStep<double>(long long, int, double, ReplayBatch<double>&, int) const;
+template void ReplayBuffer::nStep<float>(long long, int, double, ReplayBatch<float>&, int, const GoalOverride*) const;
+template void ReplayBuffer::nStep<double>(long long, int, double, ReplayBatch<double>&, int, const GoalOverride*) const;
 
 }  // namespace masa::sac

@@ -12,6 +12,7 @@
 #include "common/model/method.hpp"
 #include "common/sim/registry.hpp"
 #include "learner/run_directory.hpp"
+#include "learner/sac/hindsight.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_policy_file.hpp"
 #include "learner/sac/trainer_factory.hpp"
@@ -46,6 +47,7 @@ struct SacRun::Impl {
   ReplayBuffer replay;
   std::unique_ptr<task::TaskFactory> factory;
   std::unique_ptr<task::Task> env;
+  std::unique_ptr<Hindsight> hindsight;  // goal relabeling of the batches (off: the replay's own draws)
   std::vector<std::string> progress_names;
   std::ofstream csv;
   long long t_done = 0;    // environment steps taken
@@ -67,6 +69,7 @@ struct SacRun::Impl {
     trainer = makeTrainer(sc, spec, policy, q, q_target);  // after the initialization: TD3 copies the policy
     factory = std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, spec, rc.env, rc.origin);
     env = factory->create();
+    hindsight = std::make_unique<Hindsight>(rc, sc, env->goalRelabeling(), spec);
     progress_names = env->progressNames();
     obs.resize(spec.obsDim());
     if (!opt.resume) learner::refuseRunDirInUse(opt.run_dir);
@@ -197,6 +200,9 @@ SacRunResult SacRun::run() {
                 m.rc.task.c_str(), sc.algorithm == "td3" ? "TD3" : "SAC", model::methodName(m.rc.method).c_str(),
                 static_cast<unsigned long long>(m.rc.seed),
                 sc.env_steps, sc.learning_starts, sc.updates_per_step, sc.batch_size, sc.n_step, m.opt.run_dir.c_str());
+  if (m.opt.verbose && m.hindsight->enabled())
+    std::printf("hindsight relabeling: %.0f%% of each batch gets a goal achieved later in its episode%s\n", 100.0 * sc.her_share,
+                sc.her_future_window > 0 ? (" (within " + std::to_string(sc.her_future_window) + " steps)").c_str() : "");
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   std::vector<float>& obs = m.obs;
@@ -232,7 +238,7 @@ SacRunResult SacRun::run() {
     if (t >= sc.learning_starts) {
       // The steps this many transitions are owed (the schedule has no state of its own to resume).
       for (long long owed = gradientStepsOwed(sc, t - sc.learning_starts + 1); m.trainer->steps() < owed;) {
-        m.replay.sample(sc.batch_size, sc.n_step, sc.discount, m.rng, batch);
+        m.hindsight->sample(m.replay, sc.batch_size, sc.n_step, sc.discount, m.rng, batch);
         const SacStats s = m.trainer->step(batch, m.rng);
         sums.q_loss += s.q_loss;
         sums.actor_loss += s.actor_loss;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -22,6 +23,78 @@ namespace {
 
 constexpr int kFingers = 3;
 constexpr int kJoints = 9;
+
+// The keypoint reward's raw value: the mean over the 8 cube corners of the kernel
+// 1/(exp(s d) + 2 + exp(-s d)) of the distance between the same corner of the cube and the goal.
+double keypointKernel(const Eigen::Vector3d& cube_pos, const Eigen::Matrix3d& cube_rot, const Eigen::Vector3d& goal_pos,
+                      const Eigen::Matrix3d& goal_rot, double half, double scale) {
+  double kernel = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d local(corner & 1 ? half : -half, corner & 2 ? half : -half, corner & 4 ? half : -half);
+    const double d = ((cube_pos + cube_rot * local) - (goal_pos + goal_rot * local)).norm();
+    kernel += 1.0 / (std::exp(scale * d) + 2.0 + std::exp(-scale * d));
+  }
+  return kernel / 8.0;
+}
+
+// Position error (m) and rotation angle (rad) between two poses.
+std::array<double, 2> poseError(const Eigen::Vector3d& pos, const Eigen::Quaterniond& quat, const Eigen::Vector3d& goal_pos,
+                                const Eigen::Quaterniond& goal_quat) {
+  return {(pos - goal_pos).norm(), 2.0 * std::acos(std::min(1.0, std::abs(quat.dot(goal_quat))))};
+}
+
+// Observation entries: the cube's pose (what a step achieves) and the goal pose, 7 each.
+constexpr int kCubePoseAt = 0, kGoalPoseAt = 7, kPoseSize = 7;
+
+// Hindsight relabeling (common/sim/goal_relabeling.hpp): the goal pose is the observation's
+// entries 7-13, what a step achieved is the cube's pose in its next observation (entries 0-6, the
+// same kinds in the spec, so C3 acts on both alike). Only the keypoint term depends on the goal:
+// the relabeled reward swaps it, from the stored floats, for the one of the new goal; the reach
+// term and the termination (a divergence) do not depend on it.
+class TrifingerGoal final : public GoalRelabeling {
+ public:
+  TrifingerGoal(double keypoint_weight, double half, double scale, double pos_tol, double rot_tol)
+      : weight_(keypoint_weight), half_(half), scale_(scale), pos_tol_(pos_tol), rot_tol_(rot_tol) {
+    for (int k = 0; k < kPoseSize; ++k) {
+      goal_.push_back(kGoalPoseAt + k);
+      achieved_.push_back(kCubePoseAt + k);
+    }
+  }
+  const std::vector<int>& goalEntries() const override { return goal_; }
+  const std::vector<int>& achievedEntries() const override { return achieved_; }
+
+  RelabeledStep relabel(const float* obs, const float* next_obs, double reward, bool terminated,
+                        const float* goal) const override {
+    const Pose cube = poseOf(next_obs + kCubePoseAt), old_goal = poseOf(obs + kGoalPoseAt), new_goal = poseOf(goal);
+    RelabeledStep out;
+    out.terminated = terminated;
+    out.reward = terminated ? reward
+                            : reward + weight_ * (kernel(cube, new_goal) - kernel(cube, old_goal));
+    const auto e = poseError(cube.pos, cube.quat, new_goal.pos, new_goal.quat);
+    out.success = e[0] <= pos_tol_ && e[1] <= rot_tol_;
+    return out;
+  }
+
+ private:
+  struct Pose {
+    Eigen::Vector3d pos;
+    Eigen::Quaterniond quat;
+    Eigen::Matrix3d rot;
+  };
+  static Pose poseOf(const float* p) {
+    Pose out;
+    out.pos = Eigen::Vector3d(p[0], p[1], p[2]);
+    out.quat = Eigen::Quaterniond(p[3], p[4], p[5], p[6]).normalized();
+    out.rot = out.quat.toRotationMatrix();
+    return out;
+  }
+  double kernel(const Pose& cube, const Pose& goal) const {
+    return keypointKernel(cube.pos, cube.rot, goal.pos, goal.rot, half_, scale_);
+  }
+
+  double weight_, half_, scale_, pos_tol_, rot_tol_;
+  std::vector<int> goal_, achieved_;
+};
 
 class TrifingerLift final : public Task {
  public:
@@ -160,15 +233,7 @@ class TrifingerLift final : public Task {
     const Eigen::Vector3d cp(data_->qpos + cube_qpos_);
     const double* c = data_->qpos + cube_qpos_;
     const Eigen::Matrix3d rc = Eigen::Quaterniond(c[3], c[4], c[5], c[6]).normalized().toRotationMatrix();
-    const Eigen::Matrix3d rg = goal_quat_.toRotationMatrix();
-    double kernel = 0.0;
-    for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d local(corner & 1 ? cube_half_ : -cube_half_, corner & 2 ? cube_half_ : -cube_half_,
-                                  corner & 4 ? cube_half_ : -cube_half_);
-      const double d = ((cp + rc * local) - (goal_pos_ + rg * local)).norm();
-      kernel += 1.0 / (std::exp(keypoint_scale_ * d) + 2.0 + std::exp(-keypoint_scale_ * d));
-    }
-    raw[0] = kernel / 8.0;
+    raw[0] = keypointKernel(cp, rc, goal_pos_, goal_quat_.toRotationMatrix(), cube_half_, keypoint_scale_);
     raw[1] = tipDistanceSum() - prev_tip_distance_;
   }
 
@@ -186,9 +251,14 @@ class TrifingerLift final : public Task {
   std::vector<std::string> progressNames() const override { return {"position_error_m", "orientation_error_rad"}; }
   void progress(double* out) const override {
     const double* c = data_->qpos + cube_qpos_;
-    const Eigen::Quaterniond q = Eigen::Quaterniond(c[3], c[4], c[5], c[6]).normalized();
-    out[0] = (Eigen::Vector3d(c) - goal_pos_).norm();
-    out[1] = 2.0 * std::acos(std::min(1.0, std::abs(q.dot(goal_quat_))));
+    const auto e = poseError(Eigen::Vector3d(c), Eigen::Quaterniond(c[3], c[4], c[5], c[6]).normalized(), goal_pos_, goal_quat_);
+    out[0] = e[0];
+    out[1] = e[1];
+  }
+
+  std::unique_ptr<GoalRelabeling> goalRelabeling() const override {
+    return std::make_unique<TrifingerGoal>(termWeight("keypoints"), cube_half_, keypoint_scale_, success_pos_tol_,
+                                           success_rot_tol_);
   }
 
  protected:

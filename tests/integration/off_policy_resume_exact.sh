@@ -3,9 +3,13 @@
 # run never stopped: metrics.csv and off_policy.csv, round by round, are the uninterrupted run's
 # (clocks aside). The replay buffer, the networks, their optimizers, the fitted normalizer and the
 # generator all travel in off_policy_state.bin; the stop falls after the warm-up, so all of them matter.
-#   tests/integration/off_policy_resume_exact.sh BUILD_DIR WORK_DIR
+# With `her` as the third argument the run is TriFinger's with hindsight relabeling: the streams'
+# episodes travel in the state too, and every round relabels its share of the samples.
+#   tests/integration/off_policy_resume_exact.sh BUILD_DIR WORK_DIR [her]
 source "$(dirname "$0")/masa_train_case.sh"
-tiny=(--set task=a1_beam --set learner=off_policy --set ppo.num_envs=8 --set ppo.horizon=16 --set env.max_episode_steps=40
+task=(--set task=a1_beam)
+[ "${3:-}" = her ] && task=(--set task=trifinger_lift --set sac.her_share=0.8)
+tiny=("${task[@]}" --set learner=off_policy --set ppo.num_envs=8 --set ppo.horizon=16 --set env.max_episode_steps=40
       --set sac.learning_starts=200 --set sac.updates_per_step=0.25 --set sac.batch_size=16 --set "sac.policy_hidden=[16]"
       --set "sac.q_hidden=[16]" --set sac.n_step=2 --set runner.checkpoint_every=3 --set runner.eval_every=4
       --set runner.eval_episodes=1 --set runner.plot_every=0)
@@ -17,6 +21,10 @@ cmp -s <(strip whole/metrics.csv) <(strip parts/metrics.csv) || fail "metrics.cs
 cmp -s whole/off_policy.csv parts/off_policy.csv || fail "off_policy.csv differs: $(diff whole/off_policy.csv parts/off_policy.csv | head -4)"
 steps=$(tail -n 1 whole/off_policy.csv | cut -d, -f6)
 [ "$steps" -gt 0 ] || fail "no gradient steps were taken ($steps)"
+if [ "${3:-}" = her ]; then
+  share=$(awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) if ($c == "relabeled_share") col = c; next } END { print $col }' whole/off_policy.csv)
+  awk -v s="$share" 'BEGIN { exit !(s >= 0.5 && s <= 1.0) }' || fail "the last round relabeled a share of $share, not about 0.8"
+fi
 # The state is sealed: a flipped byte is refused by name, nothing is resumed from it.
 cp -r parts damaged && printf '\xff' | dd of=damaged/off_policy_state.bin bs=1 seek=200 conv=notrunc status=none
 if "${train[@]}" --updates 14 --resume damaged > damaged.log 2>&1; then fail "a damaged off_policy_state.bin was resumed"; fi

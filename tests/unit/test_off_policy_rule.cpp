@@ -50,7 +50,7 @@ TEST(OffPolicyRule, ABatchJoinsReplayEnvironmentByEnvironmentCutAtItsEndTimeOuts
   b.truncated[b.step(1, 1)] = 1;   // env 1 is cut by the time limit at t = 1
   std::vector<float> final_obs(od, 777.0f);
   b.addFinal(1, 1, final_obs.data());
-  const ppo::PpoStats s = rule.learn(b, rng);
+  const ppo::PpoStats s = rule.learn(b, {}, rng);
   EXPECT_EQ(s.minibatches, 0);  // warming up: 6 of 1000 transitions
   ASSERT_EQ(rule.replay().size(), 6);
   EXPECT_EQ(rule.gradientSteps(), 0);
@@ -83,13 +83,13 @@ TEST(OffPolicyRule, WarmsUpThenTakesTheStepsOwedAndSendsTheNormalizerItUses) {
   const int od = rule.replay().obsDim(), ad = rule.replay().actDim();
   const auto b = batchOf(2, 3, od, ad);
   masa::lcmt_policy_params m;
-  EXPECT_EQ(rule.learn(b, rng).minibatches, 0);  // 6 < 8
+  EXPECT_EQ(rule.learn(b, {}, rng).minibatches, 0);  // 6 < 8
   rule.fillPolicyMessage(m);
   EXPECT_EQ(m.obs_dim, 0) << "while warming up the parameters go without a normalizer";
   EXPECT_EQ(m.num_params, static_cast<int>(rule.policy().params().size()));
   // 12 transitions: floor(0.5 x (12 - 8 + 1)) = 2 steps; 18: floor(0.5 x 11) = 5, 3 more.
-  EXPECT_EQ(rule.learn(b, rng).minibatches, 2);
-  EXPECT_EQ(rule.learn(b, rng).minibatches, 3);
+  EXPECT_EQ(rule.learn(b, {}, rng).minibatches, 2);
+  EXPECT_EQ(rule.learn(b, {}, rng).minibatches, 3);
   EXPECT_EQ(rule.gradientSteps(), 5);
   rule.fillPolicyMessage(m);
   ASSERT_EQ(m.obs_dim, od);
@@ -133,14 +133,14 @@ TEST(OffPolicyRule, ASavedAndReloadedStateTakesTheSameNextRoundBitForBit) {
   Rng rng_a(4), rng_b(99);
   OffPolicyRule a(rc, rng_a), b(rc, rng_b);  // b starts elsewhere: everything must come from the file
   const auto batch = batchOf(2, 3, a.replay().obsDim(), a.replay().actDim());
-  a.learn(batch, rng_a);
-  a.learn(batch, rng_a);
+  a.learn(batch, {}, rng_a);
+  a.learn(batch, {}, rng_a);
   std::stringstream state;
   a.save(state);
   b.load(state, "state");
   Rng rng_copy = rng_a;
-  a.learn(batch, rng_a);
-  b.learn(batch, rng_copy);
+  a.learn(batch, {}, rng_a);
+  b.learn(batch, {}, rng_copy);
   EXPECT_EQ(a.gradientSteps(), b.gradientSteps());
   EXPECT_EQ(a.policy().params().values(), b.policy().params().values());
   masa::lcmt_policy_params ma, mb;
@@ -167,9 +167,9 @@ TEST(OffPolicyRule, TheProgressLineShowsTheRoundsGradientStepsTemperatureAndEntr
     Rng rng(4);
     OffPolicyRule rule(rc, rng);
     const auto b = batchOf(2, 3, rule.replay().obsDim(), rule.replay().actDim());
-    rule.learn(b, rng);
+    rule.learn(b, {}, rng);
     EXPECT_EQ(learner::offPolicyProgressFigures(rule.roundFigures()), "warming up: uniform random actions, replay 6");
-    rule.learn(b, rng);  // floor(1 x (12 - 8 + 1)) = 5 steps
+    rule.learn(b, {}, rng);  // floor(1 x (12 - 8 + 1)) = 5 steps
     const std::string line = learner::offPolicyProgressFigures(rule.roundFigures());
     EXPECT_EQ(line.rfind("grad steps 5  q ", 0), 0u) << line;
     EXPECT_EQ(line.find("nan"), std::string::npos) << line;
