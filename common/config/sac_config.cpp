@@ -42,6 +42,7 @@ SacConfig readSacConfig(const config::RunConfig& rc) {
   c.td3_policy_delay = r.atLeast("td3_policy_delay", 1);
   c.her_share = r.inRange("her_share", 0.0, 1.0);
   c.her_future_window = r.atLeast("her_future_window", 0LL);
+  c.checkpoint_replay = r.atLeast("checkpoint_replay", -1LL);
   return c;
 }
 

@@ -41,6 +41,9 @@ struct SacConfig {
   // (0: to the episode's newest stored step). HER's k relabeled goals per real one is k/(k+1).
   double her_share = 0.0;
   long long her_future_window = 0;
+  // The learner's state keeps this many of the newest transitions (-1: the whole replay). A run
+  // resumed from fewer refills to learning_starts before its gradient steps go on.
+  long long checkpoint_replay = -1;
 };
 
 // Reads rc.resolved["sac"] (config::sectionOf); throws masa::ConfigError naming the key path

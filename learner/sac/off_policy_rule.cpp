@@ -19,9 +19,10 @@
 
 namespace masa::sac {
 namespace {
-// Version 2 adds the streams' episodes; a version 1 state resumes with every stream's next
-// stretch a new episode.
-constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'O', 'F', 'F', '2'};
+// Version 2 adds the streams' episodes (a version 1 state resumes with every stream's next
+// stretch a new episode), version 3 the gradient steps forgiven while a thinned replay refilled.
+constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'O', 'F', 'F', '3'};
+constexpr char kMagicV2[8] = {'M', 'A', 'S', 'A', 'O', 'F', 'F', '2'};
 constexpr char kMagicV1[8] = {'M', 'A', 'S', 'A', 'O', 'F', 'F', '1'};
 
 // The task's goal relabeling, built only when it is asked for (a task instance loads its model).
@@ -87,14 +88,22 @@ ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, std::span<const in
   ppo::PpoStats out;
   round_means_ = SacStats{};
   round_steps_ = 0;
+  round_relabeled_share_ = 0;
   if (!fitted_) return out;
+  const long long owed = gradientStepsOwed(sc_, received_ - sc_.learning_starts + 1) - forgiven_;
+  if (refilling()) {
+    // Resumed from a compact state: no steps until the replay holds learning_starts again, and
+    // none owed for the wait.
+    forgiven_ += owed - trainer_->steps();
+    return out;
+  }
   SacStats sums;
   int n = 0;
   long long relabeled = 0;
   // The gradient steps on sac.threads threads (restored after): see configs/defaults.yaml.
   const int prev_threads = omp_get_max_threads();
   omp_set_num_threads(sc_.threads);
-  for (const long long owed = gradientStepsOwed(sc_, received_ - sc_.learning_starts + 1); trainer_->steps() < owed; ++n) {
+  for (; trainer_->steps() < owed; ++n) {
     relabeled += hindsight_->sample(replay_, sc_.batch_size, sc_.n_step, sc_.discount, rng, batch_);
     const SacStats s = trainer_->step(batch_, rng);
     sums.q_loss += s.q_loss;
@@ -129,7 +138,7 @@ std::vector<std::pair<std::string, double>> OffPolicyRule::roundFigures() const 
   std::vector<std::pair<std::string, double>> figures = {{"gradient_steps", round_steps_},
           {"gradient_steps_total", static_cast<double>(trainer_->steps())},
           {"replay_size", static_cast<double>(replay_.size())},
-          {"warming_up", fitted_ ? 0.0 : 1.0},
+          {"warming_up", fitted_ && !refilling() ? 0.0 : 1.0},
           {"q_loss", mean(m.q_loss)},
           {"actor_loss", mean(m.actor_loss)},
           {"alpha_loss", mean(m.alpha_loss)},
@@ -203,7 +212,8 @@ void OffPolicyRule::save(std::ostream& os) const {
     os.write(reinterpret_cast<const char*>(norm_std_.data()), static_cast<std::streamsize>(sizeof(float) * norm_std_.size()));
   }
   trainer_->save(os);  // the policy with its normalizer, Q, Q', the optimizers
-  replay_.save(os);
+  replay_.save(os, sc_.checkpoint_replay);
+  io::writePod(os, forgiven_);
   io::writePod(os, next_episode_);
   io::writePod(os, static_cast<long long>(streams_.size()));
   for (const auto& [id, tail] : streams_) {
@@ -218,7 +228,8 @@ void OffPolicyRule::load(std::istream& is, const std::string& source_name) {
   char magic[8] = {};
   is.read(magic, sizeof magic);
   const bool v1 = is && std::string(magic, 8) == std::string(kMagicV1, 8);
-  if (!is || (!v1 && std::string(magic, 8) != std::string(kMagic, 8)))
+  const bool v2 = is && std::string(magic, 8) == std::string(kMagicV2, 8);
+  if (!is || (!v1 && !v2 && std::string(magic, 8) != std::string(kMagic, 8)))
     throw std::runtime_error(source_name + ": not an off-policy learner state");
   int32_t fitted = 0;
   if (!io::readPod(is, received_) || !io::readPod(is, fitted) || received_ < 0 || (fitted != 0 && fitted != 1))
@@ -238,6 +249,9 @@ void OffPolicyRule::load(std::istream& is, const std::string& source_name) {
   trainer_->load(is);
   replay_.load(is);
   streams_.clear();
+  forgiven_ = 0;
+  if (!v1 && !v2 && (!io::readPod(is, forgiven_) || forgiven_ < 0))
+    throw std::runtime_error(source_name + ": corrupt off-policy learner state (forgiven steps)");
   if (v1) {
     next_episode_ = 0;
     for (long long k = 0; k < replay_.size(); ++k) next_episode_ = std::max(next_episode_, replay_.episodeAt(k) + 1);

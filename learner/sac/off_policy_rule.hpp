@@ -17,6 +17,7 @@
 // hindsight relabeling (sac.her_share) draws goals from the whole episode across rounds.
 #pragma once
 
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <vector>
@@ -56,6 +57,8 @@ class OffPolicyRule final : public learner::OffPolicyLearning {
  private:
   void fitNormalizer();
   void applyNormalizer();
+  // Resumed from a state that kept fewer transitions than learning_starts: filling up again.
+  bool refilling() const { return fitted_ && replay_.size() < std::min(sc_.learning_starts, sc_.buffer_size); }
 
   config::RunConfig rc_;
   SacConfig sc_;
@@ -73,6 +76,7 @@ class OffPolicyRule final : public learner::OffPolicyLearning {
   std::map<int64_t, StreamTail> streams_;
   long long next_episode_ = 0;
   long long received_ = 0;  // transitions taken into replay since the run began
+  long long forgiven_ = 0;  // gradient steps not owed: the rounds a compact state's replay refilled
   bool fitted_ = false;     // the normalizer is fitted: learning has started
   // The fitted normalizer as the actors are sent it (kept: a reloaded normalizer would re-derive it).
   std::vector<float> norm_mean_, norm_std_;

@@ -166,7 +166,27 @@ void readVector(std::istream& is, std::vector<T>& v, long long count) {
 }
 }  // namespace
 
-void ReplayBuffer::save(std::ostream& os) const {
+void ReplayBuffer::save(std::ostream& os, long long keep_newest) const {
+  if (keep_newest >= 0 && keep_newest < size_) {
+    // The newest steps as a buffer of their own: slots 0.. in time order, episodes as they are.
+    const long long n = keep_newest;
+    os.write(kMagic, sizeof kMagic);
+    for (long long v : {static_cast<long long>(obs_dim_), static_cast<long long>(act_dim_), capacity_, n, n % capacity_, added_})
+      io::writePod(os, v);
+    auto write_slots = [&](const auto& v, long long width) {
+      for (long long age = n - 1; age >= 0; --age)
+        os.write(reinterpret_cast<const char*>(v.data() + slotOfAge(age) * width),
+                 static_cast<std::streamsize>(sizeof(v[0]) * width));
+    };
+    write_slots(obs_, obs_dim_);
+    write_slots(next_obs_, obs_dim_);
+    write_slots(actions_, act_dim_);
+    write_slots(rewards_, 1);
+    write_slots(terminated_, 1);
+    write_slots(truncated_, 1);
+    write_slots(episode_, 1);
+    return;
+  }
   os.write(kMagic, sizeof kMagic);
   for (long long v : {static_cast<long long>(obs_dim_), static_cast<long long>(act_dim_), capacity_, size_, next_, added_})
     io::writePod(os, v);

@@ -84,7 +84,9 @@ class ReplayBuffer {
              const GoalOverride* goal = nullptr) const;
 
   // Contents and position, binary with size checks (resume continues with the same samples).
-  void save(std::ostream& os) const;
+  // keep_newest >= 0 writes only the newest that many steps (a compact state that a resumed run
+  // refills); they load as a buffer of that size, oldest first.
+  void save(std::ostream& os, long long keep_newest = -1) const;
   void load(std::istream& is);  // throws std::runtime_error on a shape mismatch or truncation
 
  private:

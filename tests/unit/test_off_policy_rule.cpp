@@ -109,6 +109,43 @@ TEST(OffPolicyRule, WarmsUpThenTakesTheStepsOwedAndSendsTheNormalizerItUses) {
   for (float l : logp) EXPECT_TRUE(std::isfinite(l));
 }
 
+// sac.checkpoint_replay: the state keeps the newest transitions only; the resumed rule refills to
+// learning_starts, taking no gradient steps and owing none for the wait, then goes on at its rate.
+TEST(OffPolicyRule, ACompactStateKeepsTheNewestTransitionsAndTheResumedRunRefillsBeforeItStepsAgain) {
+  const auto rc = smallRun({"sac.learning_starts=12", "sac.updates_per_step=0.5", "sac.checkpoint_replay=2"});
+  Rng rng(2);
+  OffPolicyRule rule(rc, rng);
+  const auto b = batchOf(2, 3, rule.replay().obsDim(), rule.replay().actDim());
+  for (int k = 0; k < 4; ++k) rule.learn(b, {}, rng);  // 24 transitions: floor(0.5 x 13) = 6 steps
+  ASSERT_EQ(rule.gradientSteps(), 6);
+  std::stringstream state;
+  rule.save(state);
+  Rng other(7);
+  OffPolicyRule back(rc, other);
+  back.load(state, "state");
+  ASSERT_EQ(back.replay().size(), 2);
+  for (long long age = 0; age < 2; ++age) {  // the newest two, in order
+    const float* kept = back.replay().obsAt(back.replay().slotOfAge(age));
+    const float* was = rule.replay().obsAt(rule.replay().slotOfAge(age));
+    EXPECT_TRUE(std::equal(kept, kept + back.replay().obsDim(), was)) << "age " << age;
+  }
+  EXPECT_EQ(back.gradientSteps(), 6);
+  // 2 + 6 = 8 stored, below 12: refilling, no steps (3 were owed for these transitions).
+  EXPECT_EQ(back.learn(b, {}, other).minibatches, 0);
+  EXPECT_EQ(back.roundFigures()[3].second, 1.0) << back.roundFigures()[3].first;  // warming_up
+  // 14 stored: the round's own 3 steps, none for the wait.
+  EXPECT_EQ(back.learn(b, {}, other).minibatches, 3);
+  EXPECT_EQ(back.gradientSteps(), 9);
+  // The forgiven steps travel in the (compact) state too.
+  std::stringstream again;
+  back.save(again);
+  Rng third(8);
+  OffPolicyRule later(rc, third);
+  later.load(again, "state");
+  for (int k = 0; k < 2; ++k) later.learn(b, {}, third);  // 2 + 12 = 14 >= 12 after the second
+  EXPECT_EQ(later.gradientSteps(), 12);  // 9, then forgiven while refilling, then the round's 3
+}
+
 TEST(OffPolicyRule, AnActorWarmingUpActsUniformlyAndEachEnvironmentFromItsOwnGenerator) {
   const auto rc = smallRun();
   const auto spec = sym::SymmetrySpec::load(rc.spec_path);
