@@ -32,6 +32,9 @@ void summarizeEpisodes(const rollout::Rollout& d, UpdateReport& report, cluster:
     report.mean_return /= n;
     report.mean_length /= n;
     for (double& t : report.term_means) t /= n;
+    report.last_episodes_update = report.update;
+    report.last_return = report.mean_return;
+    report.last_length = report.mean_length;
   } else {
     // No episode ended in this batch: there is no return to report (0 would read as one).
     report.mean_return = report.mean_length = std::nan("");
@@ -111,7 +114,9 @@ std::string offPolicyProgressFigures(const std::vector<std::pair<std::string, do
     return std::nan("");
   };
   char line[200];
-  if (figure("warming_up") > 0) {
+  if (figure("warming_up") == 2) {
+    std::snprintf(line, sizeof(line), "refilling the replay after a compact resume: %.0f transitions", figure("replay_size"));
+  } else if (figure("warming_up") > 0) {
     std::snprintf(line, sizeof(line), "warming up: uniform random actions, replay %.0f", figure("replay_size"));
   } else {
     // TD3 has no temperature: alpha 0 and entropy NaN (off_policy_trainer.hpp).
@@ -143,9 +148,17 @@ void printProgress(const UpdateReport& report, const ReportColumns& columns, int
   char timing[64] = "";
   if (!std::isnan(report.learn_s) && !std::isnan(report.wait_s))
     std::snprintf(timing, sizeof(timing), "  learn %.3fs waited %.3fs", report.learn_s, report.wait_s);
-  std::printf("update %lld%s  steps %lld  fps %.0f  return %.3f  len %.1f%s  %s  dropped %lld chunks %lld envs%s%s\n",
-              static_cast<long long>(done), total, static_cast<long long>(report.env_steps), report.fps,
-              report.mean_return, report.mean_length, success,
+  // The episodes that ended in this update, or that none did (with the last ones that did).
+  char episodes[128];
+  if (report.num_episodes > 0)
+    std::snprintf(episodes, sizeof(episodes), "return %.3f  len %.1f", report.mean_return, report.mean_length);
+  else if (report.last_episodes_update > 0)
+    std::snprintf(episodes, sizeof(episodes), "no episode ended (update %lld's: return %.3f  len %.1f)",
+                  static_cast<long long>(report.last_episodes_update), report.last_return, report.last_length);
+  else
+    std::snprintf(episodes, sizeof(episodes), "no episode ended yet");
+  std::printf("update %lld%s  steps %lld  fps %.0f  %s%s  %s  dropped %lld chunks %lld envs%s%s\n",
+              static_cast<long long>(done), total, static_cast<long long>(report.env_steps), report.fps, episodes, success,
               report.algorithm_figures.empty() ? ppo : report.algorithm_figures.c_str(),
               static_cast<long long>(report.dropped_chunks), static_cast<long long>(report.dropped_envs), timing, eta);
   if (!std::isnan(report.eval_return)) {

@@ -27,6 +27,10 @@ struct UpdateReport {
   double wall_time_s = 0, fps = 0;
   int num_episodes = 0;
   double mean_return = 0, mean_length = 0, success_rate = -1;
+  // The last update in which episodes ended (0: none since the process started), and theirs: what
+  // the progress line shows when none ended in this one.
+  int64_t last_episodes_update = 0;
+  double last_return = std::nan(""), last_length = std::nan("");
   std::vector<double> term_means;
   ppo::PpoStats ppo;
   int64_t dropped_chunks = 0;  // by the assembler, every reason (lost included), since the run began

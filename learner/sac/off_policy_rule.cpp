@@ -138,7 +138,8 @@ std::vector<std::pair<std::string, double>> OffPolicyRule::roundFigures() const 
   std::vector<std::pair<std::string, double>> figures = {{"gradient_steps", round_steps_},
           {"gradient_steps_total", static_cast<double>(trainer_->steps())},
           {"replay_size", static_cast<double>(replay_.size())},
-          {"warming_up", fitted_ && !refilling() ? 0.0 : 1.0},
+          // 1: the uniform warm-up of a fresh run; 2: refilling after a compact resume.
+          {"warming_up", !fitted_ ? 1.0 : refilling() ? 2.0 : 0.0},
           {"q_loss", mean(m.q_loss)},
           {"actor_loss", mean(m.actor_loss)},
           {"alpha_loss", mean(m.alpha_loss)},

@@ -132,7 +132,8 @@ TEST(OffPolicyRule, ACompactStateKeepsTheNewestTransitionsAndTheResumedRunRefill
   EXPECT_EQ(back.gradientSteps(), 6);
   // 2 + 6 = 8 stored, below 12: refilling, no steps (3 were owed for these transitions).
   EXPECT_EQ(back.learn(b, {}, other).minibatches, 0);
-  EXPECT_EQ(back.roundFigures()[3].second, 1.0) << back.roundFigures()[3].first;  // warming_up
+  EXPECT_EQ(back.roundFigures()[3].second, 2.0) << back.roundFigures()[3].first;  // warming_up: refilling
+  EXPECT_EQ(learner::offPolicyProgressFigures(back.roundFigures()), "refilling the replay after a compact resume: 8 transitions");
   // 14 stored: the round's own 3 steps, none for the wait.
   EXPECT_EQ(back.learn(b, {}, other).minibatches, 3);
   EXPECT_EQ(back.gradientSteps(), 9);
