@@ -106,7 +106,10 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   run_id_ = options.run_id;
   if (opt_.resume) loadCheckpoint();  // sets run_id_ unless one was given
   // Rewritten on resume too: overrides given then are part of the run from now on.
-  if (isLeadRank()) std::ofstream(fs::path(dir_) / "config.yaml") << config::dumpResolved(rc_);
+  if (isLeadRank()) {
+    std::ofstream(fs::path(dir_) / "config.yaml") << config::dumpResolved(rc_);
+    openEventFile();
+  }
   if (run_id_ == 0) run_id_ = randomRunId();
   if (ranks_->size() > 1) {
     // Rank 0's run id for every rank (the actors carry one), and the same start everywhere.
@@ -392,9 +395,23 @@ void Learner::update() {
   if (!isLeadRank()) return;  // rank 0 speaks for the ranks and keeps the run directory
   publishParams();
   report();
-  if (off_policy_) appendOffPolicyRow(lag_mean, lag_max);
+  if (off_policy_) {
+    appendOffPolicyRow(lag_mean, lag_max);
+    off_policy_events_->mirrorLastRow();
+  }
   if (rc_.runner.checkpoint_every > 0 && updates_ % rc_.runner.checkpoint_every == 0) writeCheckpoint();
   if (rc_.runner.snapshot_every > 0 && updates_ % rc_.runner.snapshot_every == 0) writeSnapshot();
+}
+
+void Learner::openEventFile() {
+  events_ = std::make_unique<EventFile>(dir_);
+  // The configuration as text, at the step the run (re)starts from: a resume's overrides show.
+  events_->text("config", env_steps_, preformatted(config::dumpResolved(rc_)));
+  metrics_events_ = std::make_unique<CsvEvents>(*events_, (fs::path(dir_) / "metrics.csv").string(), "env_steps", "learn");
+  if (off_policy_)
+    off_policy_events_ =
+        std::make_unique<CsvEvents>(*events_, (fs::path(dir_) / "off_policy.csv").string(), "env_steps", "off_policy",
+                                    std::vector<std::string>{"update"});
 }
 
 void Learner::checkRanksAgree() {
@@ -415,6 +432,7 @@ void Learner::report() {
   publisher().publish(transport::kLearnerStatsChannel,
                       statsMessage(report_, columns_, run_id_, dropStats(), c.envs_stale, c.envs_overflow));
   appendMetricsRow((fs::path(dir_) / "metrics.csv").string(), report_, columns_);
+  metrics_events_->mirrorLastRow();
   if (!curve_)
     curve_ = off_policy_
                  ? std::make_unique<LearningCurve>(
@@ -523,7 +541,10 @@ void Learner::loadCheckpoint() {
   rng_text >> rng_;
   if (!rng_text) throw std::runtime_error("resume: corrupt rng state in " + dir_ + "/checkpoint.bin");
   restored_order_ = s.order;
-  if (isLeadRank()) truncateMetricsCsv((fs::path(dir_) / "metrics.csv").string(), s.updates);  // rows past the checkpoint come again
+  if (isLeadRank()) {
+    truncateMetricsCsv((fs::path(dir_) / "metrics.csv").string(), s.updates);  // rows past the checkpoint come again
+    truncateEventFile((fs::path(dir_) / EventFile::kFileName).string(), s.env_steps);  // and their events
+  }
   trainer_->learningRate().setLr(s.lr);
   adam_->config().lr = static_cast<float>(s.lr);
   if (off_policy_) readOffPolicyState();

@@ -31,6 +31,8 @@
 #include "learner/intake/batch_collector.hpp"
 #include "learner/intake/rollout_assembler.hpp"
 #include "learner/intake/round_tracker.hpp"
+#include "learner/csv_events.hpp"
+#include "learner/event_file.hpp"
 #include "learner/learning_curve.hpp"
 #include "learner/off_policy_learning.hpp"
 #include "learner/params_delivery.hpp"
@@ -147,6 +149,7 @@ class Learner {
   void checkRanksAgree();
   // Tells the update: the stats message, metrics.csv, the curve, the progress line.
   void report();
+  void openEventFile();  // rank 0: the run's TensorBoard event file, with the config as text
   void loadCheckpoint();
   void evaluate();
   double wallTime() const;
@@ -190,6 +193,9 @@ class Learner {
   std::chrono::steady_clock::time_point idle_since_;  // the end of the last update (or the start): what wait_s counts from
   std::vector<int> restored_order_;  // shuffle permutation from a checkpoint, used once
   std::unique_ptr<LearningCurve> curve_;  // made with the first update: it needs the reward terms
+  // TensorBoard: the run's event file, fed with every metrics.csv and off_policy.csv row (rank 0).
+  std::unique_ptr<EventFile> events_;
+  std::unique_ptr<CsvEvents> metrics_events_, off_policy_events_;
   int64_t max_updates_ = -1;              // of the current run(), for the ETA; -1: unknown
   double update_interval_s_ = 0;          // moving average of the wall time between updates
   UpdateReport report_;

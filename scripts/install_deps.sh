@@ -35,6 +35,8 @@ packages=(
   # policies exported to ONNX (masa_export): onnx's protobuf classes (libonnx-dev, which does not
   # pull in libprotobuf-dev), and onnx's checker for the test that reads the files as a user would
   libonnx-dev libprotobuf-dev python3-onnx
+  # TensorBoard event files, read back in the tests by an independent decoder (Python's protobuf)
+  python3-protobuf
 )
 
 # --bench: also the packages that only the comparison benchmarks need (never CI, never a training

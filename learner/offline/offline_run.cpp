@@ -9,6 +9,8 @@
 
 #include "common/model/method.hpp"
 #include "common/policy/policy_file.hpp"
+#include "learner/csv_events.hpp"
+#include "learner/event_file.hpp"
 #include "learner/learning_curve.hpp"
 #include "learner/offline/bc_trainer.hpp"
 #include "learner/offline/iql_trainer.hpp"
@@ -62,6 +64,8 @@ struct OfflineRun::Impl {
   std::unique_ptr<task::TaskFactory> factory;
   std::vector<std::string> progress_names;
   std::ofstream csv;
+  std::unique_ptr<learner::EventFile> events;  // TensorBoard
+  std::unique_ptr<learner::CsvEvents> csv_events;
   std::unique_ptr<learner::LearningCurve> curve;
   double reward_scale = 1.0;  // IQL's TD target multiplies rewards by it
 
@@ -110,6 +114,11 @@ struct OfflineRun::Impl {
     for (const auto& n : progress_names) csv << ",eval_" << n;
     csv << '\n';
     csv.precision(7);
+    // TensorBoard: the rows at their gradient step, and the config as text.
+    events = std::make_unique<learner::EventFile>(opt.run_dir);
+    events->text("config", 0, learner::preformatted(config::dumpResolved(rc)));
+    csv_events = std::make_unique<learner::CsvEvents>(*events, (fs::path(opt.run_dir) / "metrics.csv").string(), "step",
+                                                      "offline");
     const std::string title = rc.task + "  " + algoName(oc.algo) + " / " +
                               (oc.augment ? std::string("sasa-data") : model::methodName(rc.method)) + "  seed " +
                               std::to_string(rc.seed) + "  (" + std::to_string(data.size()) + " transitions)";
@@ -160,6 +169,7 @@ struct OfflineRun::Impl {
     }
     csv << '\n';
     csv.flush();
+    csv_events->mirrorLastRow();
   }
 
   void printProgress(long long step, double wall, double sps, int steps_in_row, const task::EvalSummary* eval) const {

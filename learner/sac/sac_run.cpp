@@ -11,6 +11,8 @@
 #include "common/core/binary_io.hpp"
 #include "common/model/method.hpp"
 #include "common/sim/registry.hpp"
+#include "learner/csv_events.hpp"
+#include "learner/event_file.hpp"
 #include "learner/run_directory.hpp"
 #include "learner/sac/hindsight.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
@@ -50,6 +52,8 @@ struct SacRun::Impl {
   std::unique_ptr<Hindsight> hindsight;  // goal relabeling of the batches (off: the replay's own draws)
   std::vector<std::string> progress_names;
   std::ofstream csv;
+  std::unique_ptr<learner::EventFile> events;  // TensorBoard: metrics.csv's rows and the config
+  std::unique_ptr<learner::CsvEvents> csv_events;
   long long t_done = 0;    // environment steps taken
   std::vector<float> obs;  // the observation the next action is chosen from
 
@@ -80,6 +84,8 @@ struct SacRun::Impl {
       csv.open(fs::path(opt.run_dir) / "metrics.csv", std::ios::app);
       if (!csv) throw std::runtime_error(opt.run_dir + "/metrics.csv: cannot append");
       csv.precision(7);
+      learner::truncateEventFile((fs::path(opt.run_dir) / learner::EventFile::kFileName).string(), t_done);
+      openEvents(config);
       return;
     }
     env->reset(rng);
@@ -91,6 +97,14 @@ struct SacRun::Impl {
     for (const auto& n : progress_names) csv << ",eval_" << n;
     csv << '\n';
     csv.precision(7);
+    openEvents(config);
+  }
+
+  void openEvents(const config::RunConfig& config) {
+    events = std::make_unique<learner::EventFile>(opt.run_dir);
+    events->text("config", t_done, learner::preformatted(config::dumpResolved(config)));
+    csv_events = std::make_unique<learner::CsvEvents>(*events, (fs::path(opt.run_dir) / "metrics.csv").string(), "env_step",
+                                                      sc.algorithm);
   }
 
   static constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'S', 'R', 'U', 'N'};
@@ -272,6 +286,7 @@ SacRunResult SacRun::run() {
     }
     m.csv << '\n';
     m.csv.flush();
+    m.csv_events->mirrorLastRow();
     if (m.opt.verbose) {
       std::printf("env step %lld/%lld (%.0f%%)  %.0f steps/s  elapsed %s  ETA %s  updates %lld", t, sc.env_steps,
                   100.0 * t / sc.env_steps, sps, duration(wall).c_str(), duration((sc.env_steps - t) / sps).c_str(),

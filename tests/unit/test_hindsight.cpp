@@ -391,7 +391,7 @@ TEST(Hindsight, TheDistributedLearnerKeepsAnEpisodeAcrossRoundsOnlyWhereAStretch
 
 // A point in [-1, 1]^2 moved by 0.2 a per step towards a goal drawn in the same square; reward -1
 // until it is within 0.1 of the goal, then 0 (terminal). 10 steps an episode.
-const char* kPointSpec = R"(
+const char* kPointReachSpec = R"(
 name: point_reach
 group: {type: reflection, axis: y}
 observation:
@@ -421,7 +421,7 @@ class PointGoal final : public task::GoalRelabeling {
 
 // Success rate of the deterministic policy after `steps` environment steps of TD3.
 double pointReachSuccess(double her_share) {
-  const auto spec = test::spec(kPointSpec, "spec");
+  const auto spec = test::spec(kPointReachSpec, "spec");
   SacPolicyShape shape;
   shape.method = Method::kSa;
   shape.hidden = {64, 64};
