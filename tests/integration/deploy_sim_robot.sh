@@ -202,9 +202,11 @@ crouch)
   # The roll must be what stops the runner: a watchdog trip for stale state before it (a runner not
   # scheduled for 50 ms on a loaded machine) latches the damping command instead; such a run is
   # said and tried once more.
+  # The runner outlives the simulated robot (4 s after its first command): a robot whose runner
+  # stopped damps itself after its command timeout, which would let the crouch sag.
   for attempt in 1 2; do
     "$sim" "$policy" --seed 0 --duration 4 --quiet --tilt-state-after 1.0 --tilt-rad 1.0 > "$work/sim.log" 2>&1 & pids+=($!)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 3.8 --quiet > "$work/deploy.log" 2>&1
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 4.8 --quiet > "$work/deploy.log" 2>&1
     rc=$?
     wait "${pids[-1]}"
     [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
