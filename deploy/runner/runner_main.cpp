@@ -386,8 +386,10 @@ int runControlLoop(const DeployArgs& a, const deploy::DeployConfig& cfg, deploy:
   if (links.verifying)
     std::fprintf(stderr, "masa_deploy: state refused before decoding: %s\n", links.verifying->rejectSummary().c_str());
   if (links.command_watcher)
-    std::fprintf(stderr, "masa_deploy: commands of other runners refused before decoding: %s\n",
-                 links.command_watcher->rejectSummary().c_str());
+    std::fprintf(stderr, "masa_deploy: commands refused before decoding: %s\n", links.command_watcher->rejectSummary().c_str());
+  if (links.foreign.undecodable() > 0)
+    std::fprintf(stderr, "masa_deploy: %lld messages on %s refused by the wire guard\n",
+                 static_cast<long long>(links.foreign.undecodable()), cfg.command_channel.c_str());
   printExitLine(end, runner, safe_sent);
   return end.exit_code;
 }

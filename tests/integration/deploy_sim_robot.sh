@@ -379,7 +379,7 @@ foreign_runner_signed)
   went_on=$(sed -nE 's/.*published ([0-9]+) commands after it.*/\1/p' "$work/unsigned.log")
   [ -n "$went_on" ] && [ "$went_on" -ge 50 ] ||
     fail "the runner did not go on after the unsigned foreign command ($went_on commands after it): $(cat "$work/unsigned.log")"
-  refused=$(grep "commands of other runners refused" "$work/deploy.log") || fail "the runner did not count the refused commands"
+  refused=$(grep "masa_deploy: commands refused before decoding" "$work/deploy.log") || fail "the runner did not count the refused commands"
   for reason in unauthenticated not_permitted; do
     [[ $refused =~ MASA_ROBOT_COMMAND:\ [^\;]*$reason\ [1-9] ]] || fail "no $reason command refused: $refused"
   done
