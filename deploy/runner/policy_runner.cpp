@@ -160,6 +160,7 @@ void PolicyRunner::onState(const masa::lcmt_robot_state& s, int64_t rx_us) {
 
 int64_t PolicyRunner::nextDeadline(int64_t now_us) const {
   if (!have_state_) return INT64_MAX;
+  if (command_now_) return now_us;
   if (isLatched(mode_)) return next_due_us_;
   const int64_t stale_at = state_rx_us_ + stale_us_ + 1;
   if (!started_ || (state_fresh_ && state_rx_us_ >= next_due_us_)) return std::min(now_us, stale_at);
@@ -177,6 +178,11 @@ void PolicyRunner::trip(Mode m, std::string why) {
 
 void PolicyRunner::stop(Mode safe, const std::string& why) {
   if (!isLatched(mode_)) trip(safe, why);
+}
+
+void PolicyRunner::stopNow(Mode safe, const std::string& why) {
+  stop(safe, why);
+  command_now_ = true;
 }
 
 bool PolicyRunner::orientationBeyondLimit(std::string& why) const {
@@ -204,10 +210,10 @@ bool PolicyRunner::poll(int64_t now_us, masa::lcmt_robot_command& cmd) {
   if (!isLatched(mode_)) {
     std::string why;
     if (!state_finite_) {
-      trip(cfg_.safe_mode == SafeMode::kHold ? Mode::kHold : Mode::kDamping, "watchdog: state not finite (" + nonfinite_field_ + ")");
+      trip(safeMode(), "watchdog: state not finite (" + nonfinite_field_ + ")");
       tripped = true;
     } else if (now_us - state_rx_us_ > stale_us_) {
-      trip(cfg_.safe_mode == SafeMode::kHold ? Mode::kHold : Mode::kDamping,
+      trip(safeMode(),
            "watchdog: no new state for " + std::to_string((now_us - state_rx_us_) / 1000) + " ms (limit " +
                std::to_string(stale_us_ / 1000) + " ms)");
       tripped = true;
@@ -216,7 +222,8 @@ bool PolicyRunner::poll(int64_t now_us, masa::lcmt_robot_command& cmd) {
       tripped = true;
     }
   }
-  if (!tripped && now_us < next_due_us_) return false;
+  if (!tripped && !command_now_ && now_us < next_due_us_) return false;
+  command_now_ = false;
   answered_rx_us_ = 0;
   answered_utime_ = 0;
   if (isLatched(mode_)) {
@@ -230,7 +237,7 @@ bool PolicyRunner::poll(int64_t now_us, masa::lcmt_robot_command& cmd) {
     if (mode_ == Mode::kCalibrating) {
       calibrationTargets(dt);
     } else if (!policyTargets(dt)) {
-      trip(cfg_.safe_mode == SafeMode::kHold ? Mode::kHold : Mode::kDamping, "policy output not finite");
+      trip(safeMode(), "policy output not finite");
       safeTargets(dt);
     }
   }

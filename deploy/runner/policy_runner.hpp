@@ -85,8 +85,15 @@ class PolicyRunner {
   // processes evicted since the last command (measured under load: step p50 32 -> 12-17 us).
   // Changes no command. Nothing allocates.
   void warmUp();
-  // Switches to the safe command (latched) now, saying why (e.g. the operator stopped).
+  // Switches to the safe command (latched), saying why; it goes out at the next command's due time
+  // (the last command keeps its period: the policy step limit).
   void stop(Mode safe, const std::string& why);
+  // The same, and the next poll() gives the command at once, due or not: the run is ending (a
+  // signal, another runner, an error) and the safe command must be the last one on the wire. When
+  // already latched, the latched command goes out at once.
+  void stopNow(Mode safe, const std::string& why);
+  // The configured safe command's mode (safe.mode): kDamping or kHold.
+  Mode safeMode() const { return cfg_.safe_mode == SafeMode::kHold ? Mode::kHold : Mode::kDamping; }
   // A command message sized for this robot.
   masa::lcmt_robot_command makeCommand() const;
   // Receive time of the state the last command answered (0: none, e.g. a watchdog command).
@@ -134,6 +141,7 @@ class PolicyRunner {
   int64_t wall_minus_now_us_ = 0;  // cmd.utime - now_us, fixed at the first command
   int settled_ = 0;
   bool to_policy_ = false;
+  bool command_now_ = false;  // stopNow(): the next poll() publishes, due or not
   double interval_us_ = 0;  // mean time between states (exponential average)
   int64_t policy_steps_ = 0;
   bool started_ = false;

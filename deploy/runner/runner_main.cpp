@@ -3,7 +3,10 @@
 // Reads lcmt_robot_state on lcm.state_channel, publishes lcmt_robot_command on lcm.command_channel
 // (configs/deploy/defaults.yaml). Refuses to start while another runner publishes commands; then
 // ramps to the nominal pose, hands over to the policy, and keeps the watchdog and the limits
-// (deploy/runner/policy_runner.hpp). Ctrl-C publishes the safe command before it exits.
+// (deploy/runner/policy_runner.hpp). Every ending after the start guard puts the safe command on
+// the wire before the process exits (a signal: SIGINT, SIGTERM, SIGHUP; --duration; the policy step
+// limit; another runner; an error in the control loop); one that cannot (SIGKILL, a crash) leaves
+// the robot to its own command timeout (docs/reliability.md, "The robot's side").
 // --require-signed --trusted-keys KEYS refuses a policy file not signed by one of the Ed25519 public
 // keys in KEYS (a .pub file, or a directory of them; masa_seal keygen / sign make them).
 // --roster ROSTER --signing-key KEY signs every command as `runner 0` of the roster (masa_roster make
@@ -11,10 +14,12 @@
 // (masa_sim_robot --roster ROSTER). --verify-state (with --roster) takes only state signed by robot 0
 // of the roster and new (its counter window), refusing the rest by reason (masa_roster make DIR
 // --robot; masa_sim_robot --signing-key DIR/keys/robot0.key); without it the state is read unsigned.
-// Either way the start guard hears every runner's commands, signed or not, unverified: it errs
-// towards refusing to start.
-// Exit codes: 0 stopped (signal, --duration, --max-policy-steps), 2 error, 3 start guard refused or
-// another runner appeared, 4 stopped by the watchdog or the emergency stop (--exit-on-trip).
+// With --roster the start guard and the watch for other runners hear only commands a sender of the
+// roster signed (runner 0, a new counter); the rest are refused and counted. Without it they hear
+// every command unverified and err towards stopping (deploy/runner/foreign_runners.hpp).
+// Exit codes: 0 stopped (signal, --duration, --max-policy-steps), 2 error (in the control loop:
+// after the safe command), 3 start guard refused or another runner appeared (then after the safe
+// command), 4 stopped by the watchdog or the emergency stop (--exit-on-trip).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -31,6 +36,7 @@
 #include "common/transport/signed_publisher.hpp"
 #include "common/transport/transport.hpp"
 #include "deploy/runner/deploy_config.hpp"
+#include "deploy/runner/foreign_runners.hpp"
 #include "deploy/runner/policy_runner.hpp"
 #include "deploy/runner/realtime.hpp"
 
@@ -38,8 +44,17 @@ using namespace masa;
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-void onSignal(int) { g_stop = true; }
+std::atomic<int> g_signal{0};  // the signal that asked the runner to stop; 0: none
+void onSignal(int sig) { g_signal = sig; }
+
+const char* signalName(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+  }
+  return "a signal";
+}
 
 int64_t steadyMicros() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
@@ -199,17 +214,35 @@ std::shared_ptr<transport::MessageSigner> loadCommandSigner(const DeployArgs& a)
   return signer;
 }
 
-// Verified state (opt-in) comes through a transport of its own that checks every message against
-// the roster; the command channel stays on the plain transport, unverified, for the start guard.
+// A transport that only watches: it checks every message against the roster and hands over only
+// those that pass (the rest are counted by reason).
+std::unique_ptr<transport::Transport> openWatcher(std::shared_ptr<const transport::Roster> roster, const std::string& url) {
+  transport::SignedMode watch;
+  watch.roster = std::move(roster);
+  return std::make_unique<transport::Transport>(url, watch);
+}
+
+// Verified state (opt-in) comes through a watcher of its own.
 std::unique_ptr<transport::Transport> openVerifyingTransport(const DeployArgs& a, const std::string& url) {
   if (!a.verify_state) return nullptr;
-  transport::SignedMode watch;
-  watch.roster = std::make_shared<transport::Roster>(transport::Roster::load(a.roster_file));
-  if (!watch.roster->find({transport::Role::kRobot, 0}))
+  auto roster = std::make_shared<transport::Roster>(transport::Roster::load(a.roster_file));
+  if (!roster->find({transport::Role::kRobot, 0}))
     throw std::runtime_error("--verify-state: the roster " + a.roster_file + " names no robot 0 (masa_roster make DIR --robot)");
-  auto verifying = std::make_unique<transport::Transport>(url, watch);
+  auto verifying = openWatcher(std::move(roster), url);
   std::fprintf(stderr, "masa_deploy: state taken only signed by robot 0 of %s\n", a.roster_file.c_str());
   return verifying;
+}
+
+// With a roster, other runners' commands are heard through a watcher too: a command that another
+// runner could send counts only when a sender the roster lets command the robot signed it
+// (issue #55, item 3); an unsigned or wrongly signed one is refused, counted and changes nothing.
+std::unique_ptr<transport::Transport> openCommandWatcher(const DeployArgs& a, const std::string& url,
+                                                         const std::string& channel) {
+  if (a.roster_file.empty()) return nullptr;
+  auto watcher = openWatcher(std::make_shared<transport::Roster>(transport::Roster::load(a.roster_file)), url);
+  std::fprintf(stderr, "masa_deploy: other runners' commands on %s heard only signed by a sender of %s\n",
+               channel.c_str(), a.roster_file.c_str());
+  return watcher;
 }
 
 void printStartLine(const policy::LoadedPolicy& lp, double sym_error, const deploy::PolicyRunner& runner,
@@ -226,57 +259,76 @@ void printStartLine(const policy::LoadedPolicy& lp, double sym_error, const depl
                    .c_str());
 }
 
-// Commands of other runners on our channel, heard unverified (another runner may sign or not):
-// the start guard errs towards refusing, and a runner that appears later stops this one.
-struct ForeignRunners {
-  int64_t count = 0, last_id = 0;
-  void listen(transport::Transport& lcm, const std::string& channel, const deploy::PolicyRunner& runner, int64_t own_id) {
-    heard_ = runner.makeCommand();
-    lcm.subscribeRaw(channel, [this, own_id](const void* data, int size) {
-      size = transport::sizeWithoutSigTrailer(data, size);
-      if (transport::decodeChecked(data, size, heard_) == transport::WireVerdict::kOk && heard_.runner_id != own_id) {
-        ++count;
-        last_id = heard_.runner_id;
-      }
-    });
-  }
-
- private:
-  masa::lcmt_robot_command heard_;
-};
-
 // The runner's transports and what they have heard.
 struct Links {
-  transport::Transport& lcm;             // commands out; other runners' commands in
+  transport::Transport& lcm;             // commands out; other runners' commands in, without a roster
   transport::Transport* verifying;       // verified state in (--verify-state), else null
+  transport::Transport* command_watcher;  // other runners' commands in, verified (--roster), else null
   transport::SignedPublisher& commands;  // signs each command when a signer is given
-  ForeignRunners foreign;
+  deploy::ForeignRunners foreign;
   int64_t rejected_states = 0;           // states refused by the wire guard
   transport::Transport& stateIn() { return verifying ? *verifying : lcm; }
+  // Handles what is queued on the transports the loop does not wait on.
+  void drainOthers() {
+    if (verifying) lcm.drain();
+    if (command_watcher) command_watcher->drain();
+  }
 };
 
-// The control loop: state in, command out, until a signal, --duration, --max-policy-steps, a
-// latched trip with --exit-on-trip, or another runner. Returns the exit code.
-int runControlLoop(const DeployArgs& a, const deploy::DeployConfig& cfg, deploy::PolicyRunner& runner, Links& links) {
-  masa::lcmt_robot_command cmd = runner.makeCommand();
-  CommandLatency latency;
+// Why the run ends, and how: the exit code, the reason the log and the last command give, and
+// the mode of the safe command that goes out before the process exits.
+struct RunEnd {
+  int exit_code = 0;
+  std::string why;  // empty: the run goes on
+  deploy::Mode safe = deploy::Mode::kDamping;
+  bool at_once = true;  // false: at the next command's due time (the last policy command keeps its period)
+  bool ended() const { return !why.empty(); }
+};
+
+RunEnd whyEnd(const DeployArgs& a, const deploy::DeployConfig& cfg, const deploy::PolicyRunner& runner,
+              const Links& links, int64_t elapsed_us) {
+  if (const int sig = g_signal.load()) return {0, std::string("stopped by ") + signalName(sig), runner.safeMode()};
+  if (links.foreign.heard() > 0)
+    return {3, "another runner (id " + std::to_string(links.foreign.lastId()) + ") publishes on " + cfg.command_channel,
+            runner.safeMode()};
+  if (a.duration_s > 0 && elapsed_us >= static_cast<int64_t>(a.duration_s * 1e6))
+    return {0, "--duration reached", runner.safeMode()};
+  if (a.max_policy_steps > 0 && runner.policySteps() >= a.max_policy_steps)
+    return {0, "policy step limit reached", deploy::Mode::kHold, false};
+  return {};
+}
+
+// The last line before the exit: what the robot was left with.
+void printExitLine(const RunEnd& end, const deploy::PolicyRunner& runner, bool safe_sent) {
+  if (safe_sent)
+    std::fprintf(stderr, "masa_deploy: exit %d: %s; the last command sent was the safe command (%s)\n", end.exit_code,
+                 end.why.c_str(), deploy::modeName(runner.mode()));
+  else if (!runner.hasState())
+    std::fprintf(stderr, "masa_deploy: exit %d: %s; no robot state was heard, so no command was sent (nothing to make safe)\n",
+                 end.exit_code, end.why.c_str());
+  else
+    std::fprintf(stderr, "masa_deploy: exit %d: %s; the safe command could NOT be sent: the robot's command timeout "
+                 "must make it safe\n", end.exit_code, end.why.c_str());
+}
+
+// The control loop: state in, command out, until an ending (whyEnd) or a latched trip with
+// --exit-on-trip. Returns the run's end; safe_sent says whether LCM took its safe command.
+RunEnd controlLoop(const DeployArgs& a, const deploy::DeployConfig& cfg, deploy::PolicyRunner& runner, Links& links,
+                   masa::lcmt_robot_command& cmd, CommandLatency& latency, int64_t& published, bool& safe_sent) {
   deploy::Mode shown = deploy::Mode::kCalibrating;
   bool announced = false;
   const int64_t t0 = steadyMicros();
-  int64_t next_status = t0 + 1000000, published = 0, warmed_for = -1;
-  int exit_code = 0;
+  int64_t next_status = t0 + 1000000, warmed_for = -1;
+  RunEnd end;
   for (;;) {
     const int64_t now = steadyMicros();
-    const bool end_by_time = a.duration_s > 0 && now - t0 >= static_cast<int64_t>(a.duration_s * 1e6);
-    const bool end_by_steps = a.max_policy_steps > 0 && runner.policySteps() >= a.max_policy_steps;
-    if ((g_stop || end_by_time) && !runner.hasState()) break;  // no robot heard: nothing to make safe
-    if (g_stop || end_by_time || end_by_steps) {
-      runner.stop(end_by_steps ? deploy::Mode::kHold : cfg.safe_mode == deploy::SafeMode::kHold ? deploy::Mode::kHold : deploy::Mode::kDamping,
-                  g_stop ? "stopped by signal" : end_by_steps ? "policy step limit reached" : "--duration reached");
+    if (!end.ended() && (end = whyEnd(a, cfg, runner, links, now - t0)).ended()) {
+      if (!runner.hasState()) return end;  // no robot heard: nothing to make safe
+      if (end.at_once) runner.stopNow(end.safe, end.why); else runner.stop(end.safe, end.why);
     }
     if (runner.poll(now, cmd)) {
       const int64_t computed = steadyMicros();
-      links.commands.publish(cfg.command_channel, cmd);
+      const bool out = links.commands.publish(cfg.command_channel, cmd);
       ++published;
       if (runner.lastAnsweredRxUs() > 0) latency.add(runner.lastAnsweredRxUs(), now, computed, steadyMicros());
       if (!announced || runner.mode() != shown) {
@@ -284,17 +336,11 @@ int runControlLoop(const DeployArgs& a, const deploy::DeployConfig& cfg, deploy:
         shown = runner.mode();
         announced = true;
       }
-      if (deploy::isLatched(runner.mode()) && (g_stop || end_by_time || end_by_steps)) break;
-      if (a.exit_on_trip && deploy::isLatched(runner.mode())) {
-        exit_code = 4;
-        break;
+      if (deploy::isLatched(runner.mode()) && (end.ended() || a.exit_on_trip)) {
+        safe_sent = out;
+        if (!end.ended()) end = {4, runner.reason(), runner.mode()};
+        return end;
       }
-    }
-    if (links.foreign.count > 0) {
-      std::fprintf(stderr, "masa_deploy: another runner (id %lld) publishes on %s: stopping\n",
-                   static_cast<long long>(links.foreign.last_id), cfg.command_channel.c_str());
-      exit_code = 3;
-      break;
     }
     if (!a.quiet && now >= next_status) {
       std::fprintf(stderr, "masa_deploy: %.0f s, %s, %lld states, %lld commands, %lld policy steps\n", (now - t0) * 1e-6,
@@ -302,14 +348,50 @@ int runControlLoop(const DeployArgs& a, const deploy::DeployConfig& cfg, deploy:
                    static_cast<long long>(published), static_cast<long long>(runner.policySteps()));
       next_status += 1000000;
     }
-    // The state wakes the runner; the other runners' commands (on lcm) are read between.
+    // The state wakes the runner; the other runners' commands (on lcm or the watcher) are read between.
     waitForWork(links.stateIn(), runner, cfg, warmed_for);
-    if (links.verifying) links.lcm.drain();
+    links.drainOthers();
+  }
+}
+
+// After an error in the control loop: the safe command at once, if a robot was heard.
+bool sendSafeCommandAfterError(const deploy::DeployConfig& cfg, deploy::PolicyRunner& runner, Links& links,
+                               masa::lcmt_robot_command& cmd, const std::string& why) {
+  if (!runner.hasState()) return false;
+  try {
+    runner.stopNow(runner.safeMode(), why);
+    return runner.poll(steadyMicros(), cmd) && links.commands.publish(cfg.command_channel, cmd);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "masa_deploy: the safe command failed too: %s\n", e.what());
+    return false;
+  }
+}
+
+// The control loop and everything that ends it; returns the exit code.
+int runControlLoop(const DeployArgs& a, const deploy::DeployConfig& cfg, deploy::PolicyRunner& runner, Links& links) {
+  masa::lcmt_robot_command cmd = runner.makeCommand();
+  CommandLatency latency;
+  int64_t published = 0;
+  bool safe_sent = false;
+  RunEnd end;
+  try {
+    end = controlLoop(a, cfg, runner, links, cmd, latency, published, safe_sent);
+  } catch (const std::exception& e) {
+    end = {2, std::string("error: ") + e.what(), runner.safeMode()};
+    std::fprintf(stderr, "masa_deploy: %s\n", end.why.c_str());
+    safe_sent = sendSafeCommandAfterError(cfg, runner, links, cmd, end.why);
+    if (safe_sent) ++published;
   }
   printStopLine(runner, latency, published, links.rejected_states);
   if (links.verifying)
     std::fprintf(stderr, "masa_deploy: state refused before decoding: %s\n", links.verifying->rejectSummary().c_str());
-  return exit_code;
+  if (links.command_watcher)
+    std::fprintf(stderr, "masa_deploy: commands refused before decoding: %s\n", links.command_watcher->rejectSummary().c_str());
+  if (links.foreign.undecodable() > 0)
+    std::fprintf(stderr, "masa_deploy: %lld messages on %s refused by the wire guard\n",
+                 static_cast<long long>(links.foreign.undecodable()), cfg.command_channel.c_str());
+  printExitLine(end, runner, safe_sent);
+  return end.exit_code;
 }
 
 }  // namespace
@@ -317,8 +399,10 @@ int runControlLoop(const DeployArgs& a, const deploy::DeployConfig& cfg, deploy:
 int main(int argc, char** argv) {
   DeployArgs a;
   if (const int code = parseArgs(argc, argv, a); code >= 0) return code;
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  // SIGHUP: the terminal or ssh session that started the runner went away. SIGPIPE ignored: a
+  // closed stderr must not kill the runner before its safe command.
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, onSignal);
+  std::signal(SIGPIPE, SIG_IGN);
 
   try {
     const deploy::DeployConfig cfg = deploy::loadDeployConfig(a.config_file, a.sets);
@@ -332,10 +416,11 @@ int main(int argc, char** argv) {
     transport::Transport lcm(url);
     transport::SignedPublisher commands(lcm, loadCommandSigner(a));
     std::unique_ptr<transport::Transport> verifying = openVerifyingTransport(a, url);
+    std::unique_ptr<transport::Transport> command_watcher = openCommandWatcher(a, url, cfg.command_channel);
     printStartLine(lp, sym_error, runner, cfg, runner_id, scheduling);
 
-    Links links{lcm, verifying.get(), commands, {}, 0};
-    links.foreign.listen(lcm, cfg.command_channel, runner, runner_id);
+    Links links{lcm, verifying.get(), command_watcher.get(), commands, {}, 0};
+    links.foreign.listen(command_watcher ? *command_watcher : lcm, cfg.command_channel, runner.makeCommand(), runner_id);
     masa::lcmt_robot_state state{};
     state.joint_position.reserve(runner.numJoints());
     state.joint_velocity.reserve(runner.numJoints());
@@ -349,15 +434,22 @@ int main(int argc, char** argv) {
       runner.onState(state, rx);
     });
 
+    // Before the guard has passed, this runner has sent nothing and the robot is not its own: an
+    // ending here sends nothing either (a safe command now would be a second runner's command).
     const int64_t guard_end = steadyMicros() + static_cast<int64_t>(cfg.start_guard_s * 1e6);
-    while (steadyMicros() < guard_end && !g_stop) {
+    while (steadyMicros() < guard_end && !g_signal) {
       lcm.handleTimeout(10);
       if (verifying) verifying->drain();
+      if (command_watcher) command_watcher->drain();
     }
-    if (links.foreign.count > 0) {
-      std::fprintf(stderr, "masa_deploy: REFUSED: another runner (id %lld) publishes on %s; stop it first\n",
-                   static_cast<long long>(links.foreign.last_id), cfg.command_channel.c_str());
+    if (links.foreign.heard() > 0) {
+      std::fprintf(stderr, "masa_deploy: REFUSED: another runner (id %lld) publishes on %s; stop it first (no command sent)\n",
+                   static_cast<long long>(links.foreign.lastId()), cfg.command_channel.c_str());
       return 3;
+    }
+    if (const int sig = g_signal.load()) {
+      std::fprintf(stderr, "masa_deploy: stopped by %s during the start guard; no command sent\n", signalName(sig));
+      return 0;
     }
     std::fprintf(stderr, "masa_deploy: start guard passed (%.2f s, no other runner); waiting for state on %s\n",
                  cfg.start_guard_s, cfg.state_channel.c_str());

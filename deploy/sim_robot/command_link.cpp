@@ -11,12 +11,13 @@ bool CommandLink::loseState() {
   return true;
 }
 
-void CommandLink::receive(const masa::lcmt_robot_command& cmd, double now_s) {
+bool CommandLink::receive(const masa::lcmt_robot_command& cmd, double now_s) {
   if (lose()) {
     ++lost_commands_;
-    return;
+    return false;
   }
   pending_.push_back({now_s + delay_s_ + jitter_s_ * unit_(rng_), cmd});
+  return true;
 }
 
 bool CommandLink::takeInOrder(double now_s, masa::lcmt_robot_command& cmd) {

@@ -18,8 +18,9 @@ class CommandLink {
 
   // A state message about to go out: is it lost? (counted)
   bool loseState();
-  // A command just received at wall time now_s: lost (counted), or queued for its delivery time.
-  void receive(const masa::lcmt_robot_command& cmd, double now_s);
+  // A command just received at wall time now_s: lost (counted; returns false), or queued for its
+  // delivery time (returns true).
+  bool receive(const masa::lcmt_robot_command& cmd, double now_s);
   // Before the first command: the delivered commands in queue order; false while none is due.
   bool takeInOrder(double now_s, masa::lcmt_robot_command& cmd);
   // In control: of the commands due by now_s, the newest (by utime) replaces cmd if not older.

@@ -40,12 +40,17 @@ void RunRecord::applied(int mode, double sim_t) {
   if (fault_at_ >= 0 && safe_after_ < 0 && mode >= 2) safe_after_ = sim_t - fault_at_;
 }
 
+void RunRecord::ownSafeState(double sim_t) {
+  if (own_safe_from_ < 0) own_safe_from_ = sim_t;
+  ++own_safe_steps_;
+}
+
 void RunRecord::faultFrom(double t) {
   if (fault_at_ < 0) fault_at_ = t;
 }
 
 void RunRecord::print(double simulated_s, int64_t lost_commands, int64_t lost_states, const char* refused_summary,
-                      const std::vector<double>* final_angles) const {
+                      const std::vector<double>* final_angles, const CommandTimeout& timeout) const {
   std::printf("masa_sim_robot: commands from %zu runner(s)\n", runners_.size());
   if (refused_summary) std::printf("masa_sim_robot: commands refused before decoding: %s\n", refused_summary);
   std::printf("masa_sim_robot: %.2f s simulated, %lld commands received (%lld lost), %lld states lost; command modes:"
@@ -68,6 +73,13 @@ void RunRecord::print(double simulated_s, int64_t lost_commands, int64_t lost_st
     for (double q : *final_angles) std::printf(" %.3f", q);
     std::printf("\nmasa_sim_robot: fastest target change between emergency-stop commands: %.3f rad/s\n", estop_max_rate_);
   }
+  if (timeout.firstSilenceS() >= 0)
+    std::printf("masa_sim_robot: command timeout: no command for %.3f s (bound %.3f s) from runner %lld: the robot's own "
+                "damping for %lld physics steps from %.3f s simulated (kp 0, kd %g); that runner was not followed again "
+                "(%lld of its commands ignored)\n",
+                timeout.firstSilenceS(), timeout.timeoutS(), static_cast<long long>(timeout.firstQuietRunner()),
+                static_cast<long long>(own_safe_steps_), own_safe_from_, timeout.safeCommand().kd.empty() ? 0.0 : timeout.safeCommand().kd[0],
+                static_cast<long long>(timeout.ignoredCommands()));
   // A safe command before the fault answers something else (a runner that missed its state on a
   // loaded machine), not the fault: said apart, so that a test does not time it from the fault.
   if (fault_at_ >= 0 && first_safe_at_ >= 0 && first_safe_at_ < fault_at_)

@@ -3,6 +3,9 @@
 // physics step (torque = kp (position - q) + kd (velocity - qdot) + torque_ff, clipped to the
 // actuator's range), optionally with command delay, jitter and loss of either message (one seeded
 // generator). The robot hangs still (physics paused, state published) until the first command.
+// Once commands stop arriving for --command-timeout-ms (150 ms), it damps itself (kp 0, kd
+// --damping-kd) instead of holding the last targets, and no longer follows the runner that went
+// quiet; a new runner takes over (deploy/sim_robot/command_timeout.hpp).
 //   masa_sim_robot tasks/a1_beam/policy/policy.bin --seed 0 --duration 12
 // At the end it prints the task's progress figures over the policy phase (commands in mode 1)
 // and whether the task's termination test fired (a fall). Fault injection for tests:
@@ -34,6 +37,7 @@
 #include "common/transport/signed_publisher.hpp"
 #include "common/transport/transport.hpp"
 #include "deploy/sim_robot/command_link.hpp"
+#include "deploy/sim_robot/command_timeout.hpp"
 #include "deploy/sim_robot/run_record.hpp"
 #include "deploy/sim_robot/sim_robot.hpp"
 #include "masa/lcmt_robot_command.hpp"
@@ -60,6 +64,7 @@ int main(int argc, char** argv) {
   double tilt_state_after = -1, tilt_rad = 1.0;
   int state_every = 1;
   bool quiet = false;
+  double command_timeout_ms = 150, damping_kd = 2.0;
   app.add_option("policy", policy_path, "policy file: its task is built exactly as trained")->required()->check(CLI::ExistingFile);
   app.add_option("--seed", seed, "the task resets from this seed (masa_eval's episode 0 of --seed)")->capture_default_str();
   app.add_option("--duration", duration, "seconds of simulated time after the first command")->capture_default_str()
@@ -77,6 +82,11 @@ int main(int argc, char** argv) {
   app.add_option("--state-channel", state_channel)->capture_default_str();
   app.add_option("--command-channel", command_channel)->capture_default_str();
   app.add_flag("--quiet", quiet, "no per-second status line");
+  app.add_option("--command-timeout-ms", command_timeout_ms,
+                 "no command for this long: the robot damps itself (0: hold the last command for good)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--damping-kd", damping_kd, "kd of the robot's own damping (N m s / rad; the runner's safe.damping_kd)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   std::string roster_file;
   app.add_option("--roster", roster_file,
                  "take only commands signed by a sender this roster permits on the command channel (runner 0)");
@@ -118,6 +128,10 @@ int main(int argc, char** argv) {
     transport::SignedPublisher state_out(lcm, state_signer);
     deploy::CommandLink link(loss, delay_ms, jitter_ms, fault_seed);
     deploy::RunRecord record(*task);
+    deploy::CommandTimeout command_timeout(command_timeout_ms * 1e-3, damping_kd, n);
+    if (command_timeout_ms > 0)
+      std::fprintf(stderr, "masa_sim_robot: no command for %.0f ms: the robot damps itself (kp 0, kd %g)\n",
+                   command_timeout_ms, damping_kd);
     const auto t_start = Clock::now();
     const auto wall = [&] { return std::chrono::duration<double>(Clock::now() - t_start).count(); };
     masa::lcmt_robot_command incoming{};
@@ -127,7 +141,8 @@ int main(int argc, char** argv) {
       if (!verifying) size = transport::sizeWithoutSigTrailer(data, size);
       if (transport::decodeChecked(data, size, incoming) != transport::WireVerdict::kOk || incoming.num_joints != n) return;
       record.commandArrived(incoming);
-      link.receive(incoming, wall());
+      const double now = wall();
+      if (link.receive(incoming, now)) command_timeout.arrived(incoming, now);
     });
 
     masa::lcmt_robot_state st{};
@@ -153,9 +168,11 @@ int main(int argc, char** argv) {
     int last_status = 0;
     while (!g_stop && steps * dt < duration) {
       command_in.drain();
-      link.takeNewest(wall(), cmd);  // the newest delivered command wins (jitter may reorder them)
-      record.applied(cmd.mode, steps * dt);
-      robot.step(cmd);
+      const double now = wall();
+      link.takeNewest(now, cmd);  // the newest delivered command wins (jitter may reorder them)
+      const masa::lcmt_robot_command& applied = command_timeout.commandFor(cmd, now);
+      if (&applied == &cmd) record.applied(cmd.mode, steps * dt); else record.ownSafeState(steps * dt);
+      robot.step(applied);
       ++steps;
       const double t = steps * dt;
       const bool stopped = stop_state_after >= 0 && t >= stop_state_after;
@@ -177,7 +194,7 @@ int main(int argc, char** argv) {
     const std::vector<double> angles = robot.jointAngles();
     const std::string refused = verifying ? verifying->rejectSummary() : "";
     record.print(steps * dt, link.lostCommands(), link.lostStates(), verifying ? refused.c_str() : nullptr,
-                 tilt_state_after >= 0 ? &angles : nullptr);
+                 tilt_state_after >= 0 ? &angles : nullptr, command_timeout);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_sim_robot: %s\n", e.what());

@@ -22,6 +22,15 @@
 #                 the roster and unsigned ones are refused and counted (replayed, not_permitted,
 #                 unauthenticated) and none is taken (no physics step in mode 4); a robot that does not verify takes the signed commands too; a verifying
 #                 robot refuses every command of an unsigned runner and never moves
+#   foreign_runner  one unsigned command with another runner_id stops the runner (exit 3), and the
+#                 last command it published is the safe command
+#   foreign_runner_signed  a signing runner (--roster) refuses and counts an unsigned and an
+#                 actor-signed foreign command and goes on; one signed with the runner key stops it
+#                 (exit 3) with the safe command
+#   safe_stop     --duration, SIGTERM, SIGHUP and SIGINT end the run (exit 0) with the safe command
+#                 as the last command on the wire
+#   command_timeout  the runner is killed (no safe command): the robot damps itself within its
+#                 command timeout (150 ms default, and --command-timeout-ms 100)
 #   signed_state  the robot signs its state as robot 0 (masa_roster make --robot; masa_sim_robot
 #                 --signing-key) and the runner verifies it (--verify-state): it walks the robot while
 #                 a forger's replayed, actor-signed and unsigned states (NaN angles, a utime from the
@@ -193,9 +202,11 @@ crouch)
   # The roll must be what stops the runner: a watchdog trip for stale state before it (a runner not
   # scheduled for 50 ms on a loaded machine) latches the damping command instead; such a run is
   # said and tried once more.
+  # The runner outlives the simulated robot (4 s after its first command): a robot whose runner
+  # stopped damps itself after its command timeout, which would let the crouch sag.
   for attempt in 1 2; do
     "$sim" "$policy" --seed 0 --duration 4 --quiet --tilt-state-after 1.0 --tilt-rad 1.0 > "$work/sim.log" 2>&1 & pids+=($!)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 3.8 --quiet > "$work/deploy.log" 2>&1
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 4.8 --quiet > "$work/deploy.log" 2>&1
     rc=$?
     wait "${pids[-1]}"
     [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
@@ -314,5 +325,122 @@ signed_state)
   echo "runner that does not verify: $(grep -m1 -oE '(damping|hold|emergency stop): .*' "$work/deploy2.log")"
   echo "PASS: the verifying runner took the robot's signed state only; replayed, actor-signed and unsigned state were refused"
   ;;
-*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands|signed_state PORT"; exit 2 ;;
+foreign_runner)
+  # One unsigned command with another runner_id, as anyone on the robot's LAN can send, 2 s into the
+  # policy: the runner stops (exit 3), and the last command it put on the wire is the safe one.
+  foreign="$build/tests/masa_test_foreign_runner"
+  [ -x "$foreign" ] || fail "$foreign is missing: build first"
+  for attempt in 1 2; do
+    "$sim" "$policy" --seed 0 --duration 6 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$foreign" --after 100 --id 77 > "$work/foreign.log" 2>&1 & foreign_pid=$!; pids+=($foreign_pid)
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" --quiet > "$work/deploy.log" 2>&1
+    rc=$?
+    wait "$foreign_pid"; kill -INT "$sim_pid" 2>/dev/null; wait "$sim_pid"
+    retry_after_stale_trip $attempt "before the foreign command" || break
+  done
+  [ $rc -eq 3 ] || fail "masa_deploy exited with $rc, expected 3 (another runner)"
+  grep -q "another runner (id 77) publishes on MASA_ROBOT_COMMAND" "$work/deploy.log" || fail "masa_deploy did not say why it stopped"
+  grep -q "foreign runner: sent 1 command as runner 77 (unsigned)" "$work/foreign.log" || fail "the foreign command was not sent"
+  line=$(grep "published .* after it" "$work/foreign.log") || fail "no report of what the runner published after the foreign command"
+  echo "$line"
+  [[ $line =~ last:\ mode\ 2,.*kp\ max\ 0, ]] ||
+    fail "the runner's last command after the foreign one is not the safe command (damping: mode 2, kp 0): $line"
+  echo "PASS: a foreign runner's command ended the run (exit 3) with the safe command on the wire"
+  ;;
+foreign_runner_signed)
+  # A runner that signs (--roster) hears only verified commands: an unsigned one and one signed with
+  # an actor's key of the roster, both with another runner_id, are refused and counted and the runner
+  # goes on; a command signed with the roster's runner key (a second runner holding it, started
+  # after this one) stops it (exit 3) with the safe command.
+  foreign="$build/tests/masa_test_foreign_runner"
+  roster_bin="$build/tools/masa_roster"
+  for b in "$roster_bin" "$foreign"; do [ -x "$b" ] || fail "$b is missing: build first"; done
+  "$roster_bin" make "$work/keys" --actors 1 --runner > "$work/roster.log" 2>&1 || fail "masa_roster make failed"
+  roster="$work/keys/roster"
+  for attempt in 1 2; do
+    "$sim" "$policy" --seed 0 --duration 8 --quiet --roster "$roster" > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$foreign" --after 60 --id 77 > "$work/unsigned.log" 2>&1 & f1=$!; pids+=($f1)
+    "$foreign" --after 70 --id 78 --roster "$roster" --signing-key "$work/keys/keys/actor0.key" --as actor \
+      > "$work/actor.log" 2>&1 & f2=$!; pids+=($f2)
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" --roster "$roster" \
+      --signing-key "$work/keys/keys/runner0.key" --quiet > "$work/deploy.log" 2>&1 & deploy_pid=$!; pids+=($deploy_pid)
+    # Started after the runner, its counters are above the runner's: new to the runner's window.
+    sleep 1
+    "$foreign" --after 150 --id 79 --roster "$roster" --signing-key "$work/keys/keys/runner0.key" --as runner \
+      > "$work/runner_key.log" 2>&1 & f3=$!; pids+=($f3)
+    wait "$deploy_pid"; rc=$?
+    wait "$f1"; wait "$f2"; wait "$f3"; kill -INT "$sim_pid" 2>/dev/null; wait "$sim_pid"
+    retry_after_stale_trip $attempt "before the foreign commands" || break
+  done
+  ! grep -q "another runner (id 7[78])" "$work/deploy.log" || fail "an unverified foreign command stopped the runner: $(grep 'another runner' "$work/deploy.log")"
+  grep -q "foreign runner: sent 1 command as runner 77 (unsigned)" "$work/unsigned.log" || fail "the unsigned command was not sent"
+  grep -q "foreign runner: sent 1 command as runner 78 (signed as actor 0)" "$work/actor.log" || fail "the actor-signed command was not sent"
+  grep -q "foreign runner: sent 1 command as runner 79 (signed as runner 0)" "$work/runner_key.log" || fail "the runner-signed command was not sent"
+  went_on=$(sed -nE 's/.*published ([0-9]+) commands after it.*/\1/p' "$work/unsigned.log")
+  [ -n "$went_on" ] && [ "$went_on" -ge 50 ] ||
+    fail "the runner did not go on after the unsigned foreign command ($went_on commands after it): $(cat "$work/unsigned.log")"
+  refused=$(grep "masa_deploy: commands refused before decoding" "$work/deploy.log") || fail "the runner did not count the refused commands"
+  for reason in unauthenticated not_permitted; do
+    [[ $refused =~ MASA_ROBOT_COMMAND:\ [^\;]*$reason\ [1-9] ]] || fail "no $reason command refused: $refused"
+  done
+  echo "$refused; the runner published $went_on commands after the unsigned one"
+  [ $rc -eq 3 ] || fail "masa_deploy exited with $rc, expected 3 (a second runner with the runner key)"
+  grep -q "another runner (id 79) publishes on MASA_ROBOT_COMMAND" "$work/deploy.log" || fail "masa_deploy did not say why it stopped"
+  line=$(grep "published .* after it" "$work/runner_key.log") || fail "no report of what the runner published after the signed foreign command"
+  echo "$line"
+  [[ $line =~ last:\ mode\ 2,.*kp\ max\ 0, ]] || fail "the last command after the signed foreign one is not the safe command: $line"
+  echo "PASS: unverified foreign commands were refused and counted; a verified one ended the run with the safe command"
+  ;;
+safe_stop)
+  # --duration, SIGTERM, SIGHUP (a closed terminal or ssh session) and SIGINT end the run with exit
+  # 0, and the last command on the wire is the safe command.
+  foreign="$build/tests/masa_test_foreign_runner"
+  [ -x "$foreign" ] || fail "$foreign is missing: build first"
+  for how in duration TERM HUP INT; do
+    for attempt in 1 2; do
+      "$sim" "$policy" --seed 0 --duration 4 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+      "$foreign" --after -1 --duration 10 > "$work/witness.log" 2>&1 & witness_pid=$!; pids+=($witness_pid)
+      if [ $how = duration ]; then
+        timeout -s KILL 20 "$deploy" "$policy" --config "$config" --duration 2.5 --quiet > "$work/deploy.log" 2>&1
+        rc=$?
+      else
+        "$deploy" "$policy" --config "$config" --quiet > "$work/deploy.log" 2>&1 & deploy_pid=$!; pids+=($deploy_pid)
+        sleep 2.5
+        kill -$how "$deploy_pid"
+        wait "$deploy_pid"; rc=$?
+      fi
+      wait "$witness_pid"; kill -INT "$sim_pid" 2>/dev/null; wait "$sim_pid"
+      retry_after_stale_trip $attempt "before the $how stop" || break
+    done
+    [ $rc -eq 0 ] || fail "$how: masa_deploy exited with $rc, expected 0"
+    line=$(grep "published .* commands; last" "$work/witness.log") || fail "$how: no witness report"
+    [[ $line =~ last:\ mode\ 2,.*kp\ max\ 0, ]] || fail "$how: the last command on the wire is not the safe command: $line"
+    echo "$how: $line"
+  done
+  echo "PASS: --duration, SIGTERM, SIGHUP and SIGINT ended the run with the safe command on the wire"
+  ;;
+command_timeout)
+  # The runner is killed (SIGKILL: no safe command) 2.5 s into the run: the robot damps itself once
+  # no command came for its command timeout, and says so.
+  for timeout_ms in 150 100; do
+    set_timeout=()
+    [ $timeout_ms = 150 ] || set_timeout=(--command-timeout-ms $timeout_ms)
+    "$sim" "$policy" --seed 0 --duration 4 --quiet "${set_timeout[@]}" > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$deploy" "$policy" --config "$config" --quiet > "$work/deploy.log" 2>&1 & deploy_pid=$!; pids+=($deploy_pid)
+    sleep 2.5
+    kill -KILL "$deploy_pid"; wait "$deploy_pid" 2>/dev/null
+    wait "$sim_pid" || fail "masa_sim_robot exited with $?"
+    line=$(grep "command timeout" "$work/sim.log") ||
+      fail "timeout $timeout_ms ms: the robot did not go to its safe state when commands stopped (it held the last targets): $(grep 'command modes' "$work/sim.log")"
+    silence=$(sed -nE 's/.*no command for ([0-9.]+) s.*/\1/p' <<< "$line")
+    steps=$(sed -nE 's/.*damping for ([0-9]+) physics steps.*/\1/p' <<< "$line")
+    [ -n "$silence" ] && [ -n "$steps" ] || fail "unreadable: $line"
+    # Checked once per physics step (5 ms); a few ms of scheduling on a loaded machine.
+    le "$silence" "$(awk -v t=$timeout_ms 'BEGIN { print t / 1000 + 0.03 }')" || fail "damping $silence s after the last command (bound $timeout_ms ms)"
+    [ "$steps" -gt 0 ] || fail "no physics step in the robot's own damping: $line"
+    echo "timeout $timeout_ms ms: $line"
+  done
+  echo "PASS: the robot damped itself within its command timeout once the runner was killed"
+  ;;
+*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands|signed_state|foreign_runner|foreign_runner_signed|safe_stop|command_timeout PORT"; exit 2 ;;
 esac

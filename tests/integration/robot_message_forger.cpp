@@ -7,8 +7,10 @@
 //     the robot (an actor's) ............................................................ not_permitted
 //   - the same changed command unsigned ............................................... unauthenticated
 // and at the end prints how many of each. A robot that took any changed command spends physics
-// steps in mode 4. The runner id stays the runner's: the runner's start guard, which does not
-// verify, would otherwise stop the runner (docs/reliability.md, "Signed robot commands").
+// steps in mode 4. The runner id stays the runner's, so that what is tested is the robot's
+// verification: the signing runner refuses these too (unauthenticated, not_permitted, replayed:
+// its stop line), and another runner_id on them would not stop it (deploy_sim_robot.sh
+// foreign_runner_signed).
 // With --state, the same for every new state message robot 0 signs: the replay, and the state
 // changed (NaN joint angles, utime 10 s newer) signed with the actor's key and unsigned. A runner
 // that took a changed state leaves its policy: NaN angles give the safe command, and a utime from

@@ -166,6 +166,38 @@ TEST(DeployRunner, StaleStateGivesTheSafeCommandWithinTheBoundAndSaysWhy) {
   for (const Sent& s : sent) EXPECT_EQ(s.c.mode, static_cast<int>(Mode::kDamping));
 }
 
+// Issue #55: an ending (a signal, another runner, an error) puts the configured safe command on the
+// wire at once, not at the next due time; already latched, the latched command goes out at once.
+TEST(DeployRunner, StopNowGivesTheConfiguredSafeCommandAtOnce) {
+  RunnerFixture f;
+  for (const SafeMode safe : {SafeMode::kDamping, SafeMode::kHold}) {
+    DeployConfig cfg = testConfig();
+    cfg.safe_mode = safe;
+    PolicyRunner r(f.lp, cfg, 1);
+    int64_t utime = 0;
+    auto sent = drive(r, *f.sim, 0, 1000000, 5000, utime);
+    ASSERT_EQ(sent.back().c.mode, static_cast<int>(Mode::kPolicy));
+    const int64_t now = sent.back().t + 100;  // the next command is a period away
+    ASSERT_GT(r.nextCommandDueUs(), now);
+    masa::lcmt_robot_command cmd = r.makeCommand();
+    EXPECT_FALSE(r.poll(now, cmd)) << "no command is due yet";
+    EXPECT_EQ(r.safeMode(), safe == SafeMode::kHold ? Mode::kHold : Mode::kDamping);
+    r.stopNow(r.safeMode(), "stopped by SIGTERM");
+    EXPECT_EQ(r.nextDeadline(now), now);
+    ASSERT_TRUE(r.poll(now, cmd)) << "the safe command waited for its due time";
+    EXPECT_EQ(cmd.mode, static_cast<int>(r.safeMode()));
+    for (int k = 0; k < r.numJoints(); ++k) EXPECT_EQ(cmd.kp[k], safe == SafeMode::kHold ? cfg.hold_kp : 0.0);
+    EXPECT_EQ(r.reason(), "stopped by SIGTERM");
+    // One command at once, then the period again.
+    EXPECT_FALSE(r.poll(now + 100, cmd));
+    // Latched already: a second ending sends the latched command at once and keeps its reason.
+    r.stopNow(Mode::kDamping, "another runner");
+    ASSERT_TRUE(r.poll(now + 200, cmd));
+    EXPECT_EQ(cmd.mode, static_cast<int>(r.safeMode()));
+    EXPECT_EQ(r.reason(), "stopped by SIGTERM");
+  }
+}
+
 TEST(DeployRunner, RepeatedStateIsStaleToo) {
   RunnerFixture f;
   PolicyRunner r(f.lp, testConfig(), 1);
