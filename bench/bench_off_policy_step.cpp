@@ -14,8 +14,9 @@
 // under 1%). A SAC step is B x (4 F_pi + 6 F_q): the policy forward on o' and its training step
 // (3x: forward, dx, dW); the target twin Q forward (1x), the twin Q training step (3x), and the
 // twin Q forward and dx in the actor step (2x). A TD3 step with policy delay d is
-// B x (F_pi + 4 F_q + (3 F_pi + 2 F_q) / d): the target policy and the target twin Q forward, the
-// twin Q training step every step; the actor step (policy 3x, twin Q forward and dx) every d-th.
+// B x (F_pi + 4 F_q + (3 F_pi + F_q) / d): the target policy and the target twin Q forward, the
+// twin Q training step every step; the actor step (policy 3x, Q_1's forward and dx, each half of a
+// twin Q pass) every d-th.
 // Biases, activations and the losses are not counted.
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -103,7 +104,7 @@ void BM_OffPolicyStep(benchmark::State& state) {
   {
     const int agents = method == model::Method::kMasa ? sp.numAgents() : 1;
     const double f_pi = forwardFlopsPerSample(policy.params(), agents), f_q = forwardFlopsPerSample(q.params(), agents);
-    const double flops_per_step = td3 ? B * (f_pi + 4 * f_q + (3 * f_pi + 2 * f_q) / sc.td3_policy_delay)
+    const double flops_per_step = td3 ? B * (f_pi + 4 * f_q + (3 * f_pi + f_q) / sc.td3_policy_delay)
                                       : B * (4 * f_pi + 6 * f_q);
     const double gflops = flops_per_step * steps * 1e-9 / seconds;
     state.counters["MFLOP_per_step"] = flops_per_step * 1e-6;
