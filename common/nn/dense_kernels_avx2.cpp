@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <type_traits>
+#include <vector>
 
 #include "common/core/check.hpp"
 #include "common/core/types.hpp"
@@ -306,19 +307,41 @@ inline void forNarrowBlocks(int rows, F&& f) {
   });
 }
 
-// Panels outer, column tiles inner: a panel of W (24 rows x depth, 24 KiB at depth 256) stays in
-// L1 while the columns of x stream past it, contiguous and prefetched. The other way round (the
-// AVX-512 kernels' order, with 48 KiB of L1 on Zen 5) reads W from L2 for every 4 columns, 2 cache
-// lines 1 KiB apart per k, which Zen 3's 32 KiB L1 and 32-byte L2 port do not keep up with.
+// A panel of W (MV vectors of rows x depth) copied to one contiguous run, k by k, the rows past
+// `rows` zero. In place, its rows of column k lie ldw floats apart: at ldw = 256, 1 KiB, so all
+// of a panel's lines fall into 8 of the L1's 64 sets and evict one another.
+void copyPanel(const float* w, Index ldw, int valid_rows, int width, int depth, float* panel) {
+  for (int k = 0; k < depth; ++k, w += ldw, panel += width) {
+    std::copy_n(w, valid_rows, panel);
+    std::fill(panel + valid_rows, panel + width, 0.f);
+  }
+}
+
+// The calling thread's panel buffer, grown to the widest panel seen (then never again).
+float* panelBuffer(Index floats) {
+  thread_local std::vector<float> buffer;
+  if (static_cast<Index>(buffer.size()) < floats) buffer.resize(floats);
+  return buffer.data();
+}
+
+// Panels outer, column tiles inner: a panel of W (24 rows x depth, 24 KiB at depth 256), copied
+// contiguous, stays in L1 while the columns of x stream past it, contiguous and prefetched. The
+// other way round (the AVX-512 kernels' order, with 48 KiB of L1 on Zen 5) reads W from L2 for
+// every 4 columns, which Zen 3's 32 KiB L1 and 32-byte L2 port do not keep up with.
 template <Activation A>
 void forwardAct(const float* w, Index ldw, int rows, int depth, const float* bias, const float* x, Index ldx, float* y,
                 Index ldy, int n) {
   const int wide = n / kTileCols * kTileCols;
-  forPanels(rows, [&](auto mv, auto masked, int row0, Mask mask) {
-    for (int j = 0; j < wide; j += kTileCols)
-      forwardTile<A, decltype(mv)::value, kTileCols, decltype(masked)::value>(
-          w + row0, ldw, depth, bias ? bias + row0 : nullptr, x + j * ldx, ldx, y + j * ldy + row0, ldy, mask);
-  });
+  if (wide > 0) {
+    float* panel = panelBuffer(static_cast<Index>(3 * kLanes) * depth);
+    forPanels(rows, [&](auto mv, auto masked, int row0, Mask mask) {
+      constexpr int MV = decltype(mv)::value;
+      copyPanel(w + row0, ldw, std::min(MV * kLanes, rows - row0), MV * kLanes, depth, panel);
+      for (int j = 0; j < wide; j += kTileCols)
+        forwardTile<A, MV, kTileCols, decltype(masked)::value>(panel, MV * kLanes, depth, bias ? bias + row0 : nullptr,
+                                                               x + j * ldx, ldx, y + j * ldy + row0, ldy, mask);
+    });
+  }
   // The last 1-3 columns in narrow tiles (W read once more).
   forColumnTiles(n - wide, [&](auto nr, int j0) {
     constexpr int NR = decltype(nr)::value;
