@@ -1,18 +1,23 @@
 // Gradient steps per second of the off-policy learner (issue #34) at the recipe's batch (256) and
 // networks (policy and each Q: 256, 256, ELU, float), on 1 and 2 threads, for SA and MASA on A1
-// Beam and Humanoid Tightrope (each splits into 2 agents under MASA), SAC and TD3.
+// Beam and Humanoid Tightrope (each splits into 2 agents under MASA) and TriFinger Lift (3 agents,
+// the off-policy recipe's task of issue #50), SAC and TD3.
 //   SAC step: target (policy on o', twin target Q), twin Q step, actor step through Q, temperature,
 //             Polyak move (SacTrainer::step)
 //   TD3 step: target policy smoothing, twin Q step, every 2nd step the actor and the targets
 // The batch is drawn once from random data; the learner normalizes nothing (the identity).
 //
-// Counters: steps_per_s; for SAC also GFLOPs and of_peak (that over this machine's measured fp32
+// Counters: steps_per_s, GFLOPs and of_peak (that over this machine's measured fp32
 // FMA peak for the threads used, machine_peak.hpp). FLOPs count the networks' matrix products per
 // sample: F_pi and F_q = 2 x (the weights of the policy, of both Qs) x (agents each network runs
 // on: 1 for SA, the group's order for MASA; MASA's pooled head is counted per agent, an excess
 // under 1%). A SAC step is B x (4 F_pi + 6 F_q): the policy forward on o' and its training step
 // (3x: forward, dx, dW); the target twin Q forward (1x), the twin Q training step (3x), and the
-// twin Q forward and dx in the actor step (2x). Biases, activations and the losses are not counted.
+// twin Q forward and dx in the actor step (2x). A TD3 step with policy delay d is
+// B x (F_pi + 4 F_q + (3 F_pi + F_q) / d): the target policy and the target twin Q forward, the
+// twin Q training step every step; the actor step (policy 3x, Q_1's forward and dx, each half of a
+// twin Q pass) every d-th.
+// Biases, activations and the losses are not counted.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -34,12 +39,13 @@ using namespace masa;
 
 const bool kMachineDescribed = bench::describeMachine();
 
-const char* const kTasks[] = {"a1_beam", "humanoid_tightrope"};
+const char* const kTasks[] = {"a1_beam", "humanoid_tightrope", "trifinger_lift"};
 
 const sym::SymmetrySpec& spec(int task) {
   static const sym::SymmetrySpec specs[] = {
       sym::SymmetrySpec::load((std::filesystem::path(MASA_SOURCE_DIR) / "configs/specs/a1_beam.yaml").string()),
-      sym::SymmetrySpec::load((std::filesystem::path(MASA_SOURCE_DIR) / "configs/specs/humanoid_tightrope.yaml").string())};
+      sym::SymmetrySpec::load((std::filesystem::path(MASA_SOURCE_DIR) / "configs/specs/humanoid_tightrope.yaml").string()),
+      sym::SymmetrySpec::load((std::filesystem::path(MASA_SOURCE_DIR) / "configs/specs/trifinger_lift.yaml").string())};
   return specs[task];
 }
 
@@ -51,7 +57,7 @@ double forwardFlopsPerSample(const nn::ParameterSet<float>& params, int agents) 
   return 2.0 * weights * agents;
 }
 
-// Args: task (0 A1 Beam, 1 Humanoid Tightrope), MASA (0 SA, 1 MASA), TD3 (0 SAC, 1 TD3), threads.
+// Args: task (0 A1 Beam, 1 Humanoid Tightrope, 2 TriFinger Lift), MASA (0 SA, 1 MASA), TD3 (0 SAC, 1 TD3), threads.
 void BM_OffPolicyStep(benchmark::State& state) {
   const int task = static_cast<int>(state.range(0));
   const model::Method method = state.range(1) ? model::Method::kMasa : model::Method::kSa;
@@ -95,10 +101,11 @@ void BM_OffPolicyStep(benchmark::State& state) {
   }
   const double steps = static_cast<double>(state.iterations());
   state.counters["steps_per_s"] = steps / seconds;
-  if (!td3) {
+  {
     const int agents = method == model::Method::kMasa ? sp.numAgents() : 1;
-    const double flops_per_step =
-        B * (4 * forwardFlopsPerSample(policy.params(), agents) + 6 * forwardFlopsPerSample(q.params(), agents));
+    const double f_pi = forwardFlopsPerSample(policy.params(), agents), f_q = forwardFlopsPerSample(q.params(), agents);
+    const double flops_per_step = td3 ? B * (f_pi + 4 * f_q + (3 * f_pi + f_q) / sc.td3_policy_delay)
+                                      : B * (4 * f_pi + 6 * f_q);
     const double gflops = flops_per_step * steps * 1e-9 / seconds;
     state.counters["MFLOP_per_step"] = flops_per_step * 1e-6;
     state.counters["GFLOPs"] = gflops;
@@ -109,7 +116,7 @@ void BM_OffPolicyStep(benchmark::State& state) {
 
 void args(benchmark::internal::Benchmark* b) {
   b->ArgNames({"task", "masa", "td3", "threads"});
-  for (int task : {0, 1})
+  for (int task : {0, 1, 2})
     for (int masa : {0, 1})
       for (int td3 : {0, 1})
         for (int threads : {1, 2}) b->Args({task, masa, td3, threads});

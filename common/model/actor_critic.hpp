@@ -110,9 +110,10 @@ class ActorCritic {
   // The fused engine's chunk width of the policy and the critic networks, and what decided it
   // (nn/chunk_tuner.hpp): printed by the learner, so a run records what its CPU chose.
   std::string chunkWidthSummary() const {
-    // Without AVX-512 at build time there is no fused engine to tune (a portable -march=x86-64-v3
-    // build on the 16-core machine read "not chosen yet", which hid that its kernels were off).
-    if (!nn::dense::kAvailable) return "none: this build has no AVX-512 kernels, the generic engine runs (GemmWorkspace)";
+    // Without AVX-512 or AVX2 at build time there is no fused engine to tune (a build that reads
+    // "not chosen yet" would hide that its kernels are off).
+    if (!nn::dense::kAvailable)
+      return "none: this build has no AVX-512 or AVX2 kernels, the generic engine runs (GemmWorkspace)";
     return "policy " + policy_.net().chunkTuner().summary() + "; critic " +
            critic_.featureNet().chunkTuner().summary();
   }

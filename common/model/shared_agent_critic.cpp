@@ -45,6 +45,16 @@ Eigen::Block<Mat<S>> SharedAgentCritic<S>::forward(const ConstMatRef<S>& obs) {
 
 template <typename S>
 void SharedAgentCritic<S>::backward(const ConstMatRef<S>& dvalues, MatRef<S>* dobs) {
+  backwardThrough(dvalues, dobs, true);
+}
+
+template <typename S>
+void SharedAgentCritic<S>::inputGradient(const ConstMatRef<S>& dvalues, MatRef<S> dobs) {
+  backwardThrough(dvalues, &dobs, false);
+}
+
+template <typename S>
+void SharedAgentCritic<S>::backwardThrough(const ConstMatRef<S>& dvalues, MatRef<S>* dobs, bool parameter_grads) {
   const int b = batch_;
   const int n = maps_->num_agents, p = maps_->numPooled();
   MASA_CHECK(dvalues.rows() == 1 && dvalues.cols() == static_cast<Eigen::Index>(p) * b,
@@ -52,7 +62,10 @@ void SharedAgentCritic<S>::backward(const ConstMatRef<S>& dvalues, MatRef<S>* do
   const Eigen::Index h = pooled_.rows();
   if (dpooled_.cols() < static_cast<Eigen::Index>(p) * b) dpooled_.resize(h, static_cast<Eigen::Index>(p) * b);
   MatRef<S> dpooled = dpooled_.leftCols(static_cast<Eigen::Index>(p) * b);
-  theta_.backward(dvalues, &dpooled);
+  if (parameter_grads)
+    theta_.backward(dvalues, &dpooled);
+  else
+    theta_.inputGradient(dvalues, dpooled);
   if (dfeatures_.cols() < static_cast<Eigen::Index>(n) * b) dfeatures_.resize(h, static_cast<Eigen::Index>(n) * b);
   auto df = dfeatures_.leftCols(static_cast<Eigen::Index>(n) * b);
   for (int i = 0; i < n; ++i) {
@@ -65,7 +78,10 @@ void SharedAgentCritic<S>::backward(const ConstMatRef<S>& dvalues, MatRef<S>* do
     const Eigen::Index nb = static_cast<Eigen::Index>(n) * b;
     if (dstack_.cols() < nb) dstack_.resize(maps_->agent_input_dim, nb);
     MatRef<S> ds = dstack_.leftCols(nb);
-    psi_.backward(df, &ds);
+    if (parameter_grads)
+      psi_.backward(df, &ds);
+    else
+      psi_.inputGradient(df, ds);
     stack_.backward(ds, *dobs);
   } else {
     psi_.backward(df);

@@ -22,11 +22,16 @@ class SharedAgentCritic {
   Eigen::Block<Mat<S>> forward(const ConstMatRef<S>& obs);
   // Gradient of the last forward's values (1 x numPooled*B). dobs optional as in the policy.
   void backward(const ConstMatRef<S>& dvalues, MatRef<S>* dobs = nullptr);
+  // dobs = dL/dobs of the last forward only, the parameters' gradients left as they are (an actor
+  // trained through this critic).
+  void inputGradient(const ConstMatRef<S>& dvalues, MatRef<S> dobs);
 
   // Psi, the per-agent feature network (the critic's bulk; Theta is a small head).
   const nn::Mlp<S>& featureNet() const { return psi_; }
 
  private:
+  void backwardThrough(const ConstMatRef<S>& dvalues, MatRef<S>* dobs, bool parameter_grads);
+
   const AgentMaps* maps_;
   AgentStack<S> stack_;
   nn::Mlp<S> psi_;

@@ -11,6 +11,9 @@
 
 #include "common/nn/dense_kernels.hpp"
 
+// An AVX2 build has its own tiles and layouts (dense_kernels_avx2.cpp).
+#if !defined(MASA_DENSE_AVX2)
+
 #include <algorithm>
 #include <type_traits>
 
@@ -24,7 +27,6 @@
 namespace masa::nn::dense {
 
 namespace {
-constexpr int kLanes = 16;
 
 // Splits ceil(rows / 16) vectors into panels of 3 vectors, with 2-vector panels for a remainder
 // (v = 3q + 1 as 3(q-1) + 2 + 2): a 2 x 8 tile still hides the FMA latency, a 1 x 8 one barely.
@@ -482,7 +484,7 @@ void weightGrad(int rows, int cols, int n, const float* g, Index ldg, const floa
   }
 }
 
-#else  // no AVX-512: kAvailable is false and the MLP never calls these
+#else  // neither AVX-512 nor AVX2: kAvailable is false and the MLP never calls these
 
 void forward(const float*, Index, int, int, const float*, Activation, const float*, Index, float*, Index, int) {
   MASA_CHECK(false, "dense::forward needs AVX-512");
@@ -500,3 +502,5 @@ void weightGrad(int, int, int, const float*, Index, const float*, Index, float*,
 #endif
 
 }  // namespace masa::nn::dense
+
+#endif  // !MASA_DENSE_AVX2

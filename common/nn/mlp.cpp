@@ -179,7 +179,7 @@ Eigen::Block<Mat<S>> Mlp<S>::infer(const ConstMatRef<S>& x) {
 }
 
 template <typename S>
-void Mlp<S>::backward(const ConstMatRef<S>& dy, MatRef<S>* dx) {
+void Mlp<S>::checkBackward(const ConstMatRef<S>& dy, const MatRef<S>* dx) const {
   const int B = batch_;
   MASA_CHECK(B >= 0, "MLP backward needs a forward() first (infer() does not keep caches)");
   MASA_CHECK(dy.rows() == shape_.output && dy.cols() == B,
@@ -187,14 +187,31 @@ void Mlp<S>::backward(const ConstMatRef<S>& dy, MatRef<S>* dx) {
   if (dx)
     MASA_CHECK(dx->rows() == shape_.input && dx->cols() == B,
                "MLP backward: dx is " << dx->rows() << "x" << dx->cols() << ", expected " << shape_.input << "x" << B);
+}
+
+template <typename S>
+void Mlp<S>::backward(const ConstMatRef<S>& dy, MatRef<S>* dx) {
+  checkBackward(dy, dx);
+  const int B = batch_;
   if (B == 0) return;
   if constexpr (kFused) {
     const auto start = std::chrono::steady_clock::now();
-    backwardFused(dy, dx);
+    backwardFused(dy, dx, true);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     chunk_tuner_.record(B, backwardColumnsPerThread(B), forward_seconds_ + seconds);
   } else
-    backwardGeneric(dy, dx);
+    backwardGeneric(dy, dx, true);
+}
+
+template <typename S>
+void Mlp<S>::inputGradient(const ConstMatRef<S>& dy, MatRef<S> dx) {
+  checkBackward(dy, &dx);
+  if (batch_ == 0) return;
+  // (Not timed for the chunk tuner: it compares training steps, forward and full backward.)
+  if constexpr (kFused)
+    backwardFused(dy, &dx, false);
+  else
+    backwardGeneric(dy, &dx, false);
 }
 
 // ---- generic engine: one GemmWorkspace product per matrix, elementwise passes separate ----
@@ -219,7 +236,7 @@ void Mlp<S>::forwardGeneric(const S* x, Index ldx, int B) {
 }
 
 template <typename S>
-void Mlp<S>::backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx) {
+void Mlp<S>::backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx, bool weight_grads) {
   const int B = batch_;
   // dz of the current layer lives in `cur`; W^T dz goes to `next`, which becomes the previous
   // layer's dz in place. The two scratch buffers swap roles each layer. Derivatives are taken
@@ -238,9 +255,11 @@ void Mlp<S>::backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx) {
     auto W = std::as_const(*params_).value(l.w_offset, l.out, l.in);
     const Mat<S>& prev = k == 0 ? input_ : y_[k - 1];
     // dW += dz prev^T, db += row sums of dz, dprev = W^T dz.
-    gemm_.run(plans_[3 * k + 1], false, true, l.out, l.in, B, dz.data(), cur->rows(), prev.data(), prev.rows(),
-              params_->grad(l.w_offset, l.out, l.in).data(), l.out, true);
-    params_->grad(l.b_offset, l.out, 1).col(0) += dz.rowwise().sum();
+    if (weight_grads) {
+      gemm_.run(plans_[3 * k + 1], false, true, l.out, l.in, B, dz.data(), cur->rows(), prev.data(), prev.rows(),
+                params_->grad(l.w_offset, l.out, l.in).data(), l.out, true);
+      params_->grad(l.b_offset, l.out, 1).col(0) += dz.rowwise().sum();
+    }
     if (k == 0) {
       if (dx)
         gemm_.run(plans_[3 * k + 2], true, false, l.in, B, l.out, W.data(), l.out, dz.data(), cur->rows(), dx->data(),
@@ -257,7 +276,7 @@ void Mlp<S>::backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx) {
   }
 }
 
-// ---- fused engine (float, AVX-512): chunks of the batch through all layers, over threads ----
+// ---- fused engine (float, AVX-512 or AVX2): chunks of the batch through all layers, over threads ----
 //
 // Forward chunks are handed out dynamically: a thread whose core is shared with another process
 // takes fewer of them instead of holding the other one up at the end of the step (each column's
@@ -330,7 +349,7 @@ void Mlp<S>::inferPacked(const S* x, Index ldx, int n) {
 }
 
 template <typename S>
-void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
+void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx, bool weight_grads) {
   if constexpr (kFused) {
     const int B = batch_;
     const int L = numLayers();
@@ -368,8 +387,9 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
         const Layer& l = layers_[k];
         const Index ld_x = k == 0 ? input_.rows() : y_[k - 1].rows();
         const S* x_k = (k == 0 ? input_.data() : y_[k - 1].data()) + j0 * ld_x;
-        dense::weightGrad(l.out, l.in, n, g, ld_g, x_k, ld_x, grad + (l.w_offset - param_begin_),
-                          grad + (l.b_offset - param_begin_));
+        if (weight_grads)
+          dense::weightGrad(l.out, l.in, n, g, ld_g, x_k, ld_x, grad + (l.w_offset - param_begin_),
+                            grad + (l.b_offset - param_begin_));
         const S* packed = packed_t_.data() + packed_t_offset_[k];
         if (k > 0) {
           S* d = buffers[free_buffer];
@@ -407,7 +427,7 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
       // Thread 0 accumulates into the parameter set, the others into zeroed partials summed below.
       const int t = omp_get_thread_num(), nt = omp_get_num_threads();
       S* grad = t == 0 ? grads : grad_partial_[t - 1].data();
-      if (t > 0) grad_partial_[t - 1].setZero();
+      if (t > 0 && weight_grads) grad_partial_[t - 1].setZero();
       // The packing is a serial pass over every weight otherwise (5% of a 1024-column step on two
       // threads); each panel is written by one thread, so the packed bytes are the same.
       pack_transposes(t, nt);
@@ -419,11 +439,13 @@ void Mlp<S>::backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx) {
       const int per = blocks / nt, extra = blocks % nt;
       const int b0 = t * per + std::min(t, extra);
       blocks_in_chunks(b0, b0 + per + (t < extra ? 1 : 0), t, grad);
+      if (weight_grads) {  // (the same on every thread, so all of them or none meet the barrier)
 #pragma omp barrier
-      // (every partial is complete)
-      const auto [p0, p1] = columnRange(P, t, nt);
-      Eigen::Map<Vec<S>> total(grads + p0, p1 - p0);
-      for (int u = 1; u < nt; ++u) total += grad_partial_[u - 1].segment(p0, p1 - p0);
+        // (every partial is complete)
+        const auto [p0, p1] = columnRange(P, t, nt);
+        Eigen::Map<Vec<S>> total(grads + p0, p1 - p0);
+        for (int u = 1; u < nt; ++u) total += grad_partial_[u - 1].segment(p0, p1 - p0);
+      }
     }
   }
 }

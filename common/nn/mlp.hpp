@@ -4,12 +4,12 @@
 // capacity: a batch up to the largest seen so far reuses them (leftCols views), so the training
 // loop allocates nothing after its first step.
 //
-// Two engines behind one interface. In float on AVX-512 machines (dense::kAvailable) the layers
+// Two engines behind one interface. In float on AVX-512 or AVX2 machines (dense::kAvailable) the layers
 // run on the fused kernels of dense_kernels.hpp, and the batch is cut into chunks that the OpenMP
 // threads take in turn: a chunk goes through every layer while its activations stay in L2, and
 // each thread adds its weight gradients to its own partial, summed once at the end (no
 // synchronization between layers). The chunk width is measured on the machine during the first
-// training steps (chunk_tuner.hpp); no result depends on it. Otherwise (double, or no AVX-512) every product is one
+// training steps (chunk_tuner.hpp); no result depends on it. Otherwise (double, or neither) every product is one
 // GemmWorkspace call and the elementwise work separate passes. Only post-activations are stored
 // (f' is computed from them); hidden ones have their rows padded to a multiple of 16 so that
 // every column starts 64-byte aligned.
@@ -64,6 +64,10 @@ class Mlp {
 
   // Backward of the last forward: grads += dL/dparams; if dx is given, dx = dL/dx (input x B).
   void backward(const ConstMatRef<S>& dy, MatRef<S>* dx = nullptr);
+  // dx = dL/dx of the last forward only; the parameters' gradients are left as they are. What a
+  // network differentiated for another one's sake needs (SAC's and TD3's actor through Q): the
+  // weight-gradient products are a third of a backward's work.
+  void inputGradient(const ConstMatRef<S>& dy, MatRef<S> dx);
 
   // The fused engine's chunk width: measured during the first training steps, or forced (a
   // multiple of ChunkTuner::kBlock). Every width gives bit-identical results.
@@ -78,9 +82,11 @@ class Mlp {
   static constexpr bool kFused = std::is_same_v<S, float> && dense::kAvailable;
 
   void forwardGeneric(const S* x, Eigen::Index ldx, int B);
-  void backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx);
+  // The backward passes add parameter gradients only when weight_grads (else dx is required).
+  void backwardGeneric(const ConstMatRef<S>& dy, MatRef<S>* dx, bool weight_grads);
   void forwardFused(const S* x, Eigen::Index ldx, int B, bool keep_input);
-  void backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx);
+  void backwardFused(const ConstMatRef<S>& dy, MatRef<S>* dx, bool weight_grads);
+  void checkBackward(const ConstMatRef<S>& dy, const MatRef<S>* dx) const;
   void inferPacked(const S* x, Eigen::Index ldx, int n);
   // Threads for a batch of B columns (1 inside a parallel region or for small batches).
   int threadsFor(int B, int min_columns_per_thread) const;

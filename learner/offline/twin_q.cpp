@@ -30,7 +30,7 @@ void TwinQ<S>::initialize(Rng& rng) {
 }
 
 template <typename S>
-Eigen::Block<Mat<S>> TwinQ<S>::forward(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions) {
+MatRef<S> TwinQ<S>::pairOf(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions) {
   MASA_CHECK(obs.rows() == obs_dim_ && actions.rows() == act_dim_ && obs.cols() == actions.cols(),
              "Q input is " << obs.rows() << "x" << obs.cols() << " and " << actions.rows() << "x" << actions.cols()
                            << ", expected " << obs_dim_ << " and " << act_dim_ << " rows, equal columns");
@@ -42,10 +42,25 @@ Eigen::Block<Mat<S>> TwinQ<S>::forward(const ConstMatRef<S>& obs, const ConstMat
   auto pair = pair_.leftCols(b);
   pair.topRows(obs_dim_) = obs;
   pair.bottomRows(act_dim_) = actions;
+  return pair;
+}
+
+template <typename S>
+Eigen::Block<Mat<S>> TwinQ<S>::forward(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions) {
+  const auto pair = pairOf(obs, actions);
+  const Eigen::Index b = pair.cols();
   auto q = q_.leftCols(b);
   q.row(0) = q1_.forward(pair);
   q.row(1) = q2_.forward(pair);
   return q_.block(0, 0, 2, b);
+}
+
+template <typename S>
+Eigen::Block<Mat<S>> TwinQ<S>::q1Forward(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions) {
+  const auto pair = pairOf(obs, actions);
+  const Eigen::Index b = pair.cols();
+  q_.row(0).leftCols(b) = q1_.forward(pair);
+  return q_.block(0, 0, 1, b);
 }
 
 template <typename S>
@@ -63,6 +78,28 @@ void TwinQ<S>::backward(const ConstMatRef<S>& dq, MatRef<S>* dactions) {
   q1_.backward(dq.row(0), &d1);
   q2_.backward(dq.row(1), &d2);
   *dactions = d1.bottomRows(act_dim_) + d2.bottomRows(act_dim_);
+}
+
+template <typename S>
+void TwinQ<S>::actionGradient(const ConstMatRef<S>& dq, MatRef<S> dactions) {
+  const Eigen::Index b = dq.cols();
+  MASA_CHECK(dq.rows() == 2 && dactions.rows() == act_dim_ && dactions.cols() == b,
+             "dq must be 2 x B and dactions " << act_dim_ << " x B");
+  dpair1_.resize(obs_dim_ + act_dim_, b);
+  dpair2_.resize(obs_dim_ + act_dim_, b);
+  q1_.inputGradient(dq.row(0), dpair1_);
+  q2_.inputGradient(dq.row(1), dpair2_);
+  dactions = dpair1_.bottomRows(act_dim_) + dpair2_.bottomRows(act_dim_);
+}
+
+template <typename S>
+void TwinQ<S>::q1ActionGradient(const ConstMatRef<S>& dq1, MatRef<S> dactions) {
+  const Eigen::Index b = dq1.cols();
+  MASA_CHECK(dq1.rows() == 1 && dactions.rows() == act_dim_ && dactions.cols() == b,
+             "dq1 must be 1 x B and dactions " << act_dim_ << " x B");
+  dpair1_.resize(obs_dim_ + act_dim_, b);
+  q1_.inputGradient(dq1, dpair1_);
+  dactions = dpair1_.bottomRows(act_dim_);
 }
 
 template <typename S>

@@ -31,6 +31,16 @@ class TwinQ {
   // Accumulates parameter gradients of dL/dQ (2 x B) of the last forward. If dactions is given it
   // receives dL/da (act_dim x B), what an actor trained through Q (SAC) needs.
   void backward(const ConstMatRef<S>& dq, MatRef<S>* dactions = nullptr);
+  // dactions = dL/da (act_dim x B) of dL/dQ (2 x B) of the last forward, the parameters'
+  // gradients left as they are: an actor trained through Q (SAC) needs no Q gradients, and their
+  // products are a third of a backward.
+  void actionGradient(const ConstMatRef<S>& dq, MatRef<S> dactions);
+
+  // Q1 alone (1 x B), for an actor trained through Q1 only (TD3): half of forward(). Its view is
+  // valid until the next forward; q1ActionGradient then gives dL/da of dL/dQ1 (1 x B), the
+  // parameters' gradients left as they are.
+  Eigen::Block<Mat<S>> q1Forward(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions);
+  void q1ActionGradient(const ConstMatRef<S>& dq1, MatRef<S> dactions);
   // min(Q1, Q2) into out (1 x B): IQL's pessimistic target.
   void minQ(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions, MatRef<S> out);
 
@@ -38,6 +48,9 @@ class TwinQ {
   void moveTowards(const TwinQ& online, S rate);
 
  private:
+  // [obs; actions] into pair_ (checked), its first b columns.
+  MatRef<S> pairOf(const ConstMatRef<S>& obs, const ConstMatRef<S>& actions);
+
   model::AgentMaps maps_;
   int obs_dim_, act_dim_;
   nn::ParameterSet<S> params_;

@@ -81,10 +81,10 @@ S SacTrainer<S>::actorLoss(const ReplayBatch<S>& batch, Rng& rng) {
   dq_.resize(2, b);
   dlogp_.resize(1, b);
   const S loss = sac::actorLoss<S>(logp_, q, alpha, dlogp_, dq_);
-  // dL/da through Q; Q's own parameter gradients from this pass are not wanted: cleared.
+  // dL/da through Q. Q's own parameter gradients are not wanted: not computed, and cleared (they
+  // were the critic step's) as the losses' contract says.
   da_.resize(a, b);
-  MatRef<S> da = da_;
-  q_->backward(dq_, &da);
+  q_->actionGradient(dq_, da_);
   q_->params().zeroGrad();
   dmean_.resize(a, b);
   dlog_std_.resize(a, b);

@@ -68,14 +68,14 @@ S Td3Trainer<S>::actorLoss(const ReplayBatch<S>& batch) {
   policy_->normalize(batch.obs, obs_n_);
   policy_->forward(obs_n_);
   act_ = policy_->mean().array().tanh().matrix();
-  const auto q = q_->forward(obs_n_, act_);
-  const S loss = -q.row(0).mean();
-  // dL/dQ_1 = -1/B; dL/da through Q_1; Q's own parameter gradients from this pass: cleared.
-  dq_.setZero(2, b);
-  dq_.row(0).setConstant(S(-1) / S(b));
+  // The actor follows Q_1 alone (Fujimoto et al.): Q_2 is neither run nor differentiated.
+  const auto q1 = q_->q1Forward(obs_n_, act_);
+  const S loss = -q1.mean();
+  // dL/dQ_1 = -1/B; dL/da through Q_1. Q's own parameter gradients are not wanted: not computed,
+  // and cleared (they were the critic step's) as the losses' contract says.
+  dq1_.setConstant(1, b, S(-1) / S(b));
   da_.resize(a, b);
-  MatRef<S> da = da_;
-  q_->backward(dq_, &da);
+  q_->q1ActionGradient(dq1_, da_);
   q_->params().zeroGrad();
   dmean_ = (da_.array() * (S(1) - act_.array().square())).matrix();
   dlog_std_.setZero(a, b);

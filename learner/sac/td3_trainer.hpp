@@ -53,7 +53,7 @@ class Td3Trainer : public OffPolicyTrainer<S> {
   long long steps_ = 0;
   SacStats stats_;
 
-  Mat<S> obs_n_, next_n_, eps_, act_, min_q_, target_, dq_, da_, dmean_, dlog_std_;
+  Mat<S> obs_n_, next_n_, eps_, act_, min_q_, target_, dq_, dq1_, da_, dmean_, dlog_std_;
 };
 
 }  // namespace masa::sac

@@ -96,7 +96,7 @@ Steps trainAtWidth(int width, int batch, int steps) {
 }
 
 TEST(MlpChunkWidth, EveryWidthAndTheTuningItselfGiveBitIdenticalResults) {
-  if (!dense::kAvailable) GTEST_SKIP() << "the fused engine needs AVX-512";
+  if (!dense::kAvailable) GTEST_SKIP() << "the fused engine needs AVX-512 or AVX2";
   const int saved = omp_get_max_threads();
   for (int threads : {1, 2}) {
     omp_set_num_threads(threads);

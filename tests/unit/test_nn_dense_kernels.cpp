@@ -1,6 +1,7 @@
-// The AVX-512 dense-layer kernels against plain Eigen products, over shapes that exercise every
-// panel width (48/32/16 rows, masked last vector), every column tile (8/4/2/1), strided operands
-// and all activations; and the fused MLP engine against the double-precision generic one.
+// The dense-layer kernels (AVX-512, or AVX2 on CPUs without it) against plain Eigen products, over
+// shapes that exercise every panel width (3, 2 and 1 vectors, masked last vector), every column
+// tile, strided operands and all activations; the packed layouts of each instruction set; and the
+// fused MLP engine against the double-precision generic one.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -46,7 +47,7 @@ using Shape = std::tuple<int, int, int>;
 class DenseKernels : public ::testing::TestWithParam<Shape> {
  protected:
   void SetUp() override {
-    if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+    if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512 or AVX2";
   }
 };
 
@@ -125,7 +126,7 @@ INSTANTIATE_TEST_SUITE_P(Shapes, DenseKernels,
 // Which tile computes a column must not change a bit of it: the robot runner infers one sample (or
 // its N agents) and has to act exactly as the policy did in a batch during evaluation.
 TEST(DenseKernelsForward, AColumnIsBitIdenticalWhateverTileComputesIt) {
-  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512 or AVX2";
   for (const int rows : {21, 100, 400, 450}) {
     const int depth = 37, n = 19;  // 8 + 8 + 3 columns in one call
     const Mat<float> w = Mat<float>::Random(rows, depth);
@@ -150,7 +151,7 @@ TEST(DenseKernelsForward, AColumnIsBitIdenticalWhateverTileComputesIt) {
 // 1-4 columns, blocks of every size (450 rows: two blocks even for one column), strided x and y,
 // every activation, and rows of y beyond `rows` left alone.
 TEST(DenseKernelsForward, PackedWeightsGiveTheBitsOfWInPlace) {
-  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512 or AVX2";
   for (const int rows : {7, 21, 100, 400, 450}) {
     const int depth = 37, ldx = depth + 3, ldy = rows + 5;
     const Mat<float> w = Mat<float>::Random(rows, depth);
@@ -170,8 +171,9 @@ TEST(DenseKernelsForward, PackedWeightsGiveTheBitsOfWInPlace) {
   }
 }
 
+// AVX-512's narrow tiles: at most 28, 14, 9 and 6 vectors of 16 rows for 1-4 columns.
 TEST(DenseKernelsPack, ForwardPackHoldsEachRowBlockContiguouslyZeroPadded) {
-  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  if (!dense::kAvailable || dense::kLanes != 16) GTEST_SKIP() << "AVX-512's layout (this build: AVX2 or none)";
   const int depth = 3;
   {  // 70 rows = 5 vectors: one block for 4 columns (at most 6 vectors), 10 rows of zeros
     const Mat<float> w = Mat<float>::Random(70, depth);
@@ -194,24 +196,52 @@ TEST(DenseKernelsPack, ForwardPackHoldsEachRowBlockContiguouslyZeroPadded) {
   EXPECT_THROW(dense::packForward(unused, 1, 1, 1, 0, unused), std::exception);
 }
 
+// AVX2's narrow tiles: at most 12, 6, 4 and 3 vectors of 8 rows for 1-4 columns.
+TEST(DenseKernelsPack, Avx2ForwardPackHoldsEachRowBlockContiguouslyZeroPadded) {
+  if (!dense::kAvailable || dense::kLanes != 8) GTEST_SKIP() << "AVX2's layout (this build: AVX-512 or none)";
+  const int depth = 3;
+  {  // 20 rows = 3 vectors: one block for 4 columns (at most 3 vectors), 4 rows of zeros
+    const Mat<float> w = Mat<float>::Random(20, depth);
+    std::vector<float> packed(dense::packedSize(20, depth), -1.f);
+    dense::packForward(w.data(), 20, 20, depth, 4, packed.data());
+    for (int k = 0; k < depth; ++k)
+      for (int r = 0; r < 24; ++r) EXPECT_EQ(packed[k * 24 + r], r < 20 ? w(r, k) : 0.f);
+  }
+  {  // 100 rows = 13 vectors, 2 columns (at most 6): blocks of 5, 4 and 4 vectors, each contiguous
+    const Mat<float> w = Mat<float>::Random(100, depth);
+    std::vector<float> packed(dense::packedSize(100, depth), -1.f);
+    dense::packForward(w.data(), 100, 100, depth, 2, packed.data());
+    for (int k = 0; k < depth; ++k) {
+      for (int r = 0; r < 40; ++r) EXPECT_EQ(packed[k * 40 + r], w(r, k));
+      for (int r = 0; r < 32; ++r) EXPECT_EQ(packed[40 * depth + k * 32 + r], w(40 + r, k));
+      for (int r = 0; r < 32; ++r) EXPECT_EQ(packed[72 * depth + k * 32 + r], r < 28 ? w(72 + r, k) : 0.f);
+    }
+  }
+  float unused[16];
+  EXPECT_THROW(dense::packForward(unused, 1, 1, 1, 5, unused), std::exception);
+}
+
 TEST(DenseKernelsPack, PanelsHoldRowsOfOpWZeroPadded) {
-  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
-  // 70 rows = 5 vectors = one 48-row panel and one 32-row panel (22 valid rows).
-  const int rows = 70, depth = 3;
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512 or AVX2";
+  // 4 vectors and 6 rows = 5 vectors = one 3-vector panel and one 2-vector panel with L + 6 valid
+  // rows (L lanes: AVX-512 70 rows as 48 + 32 with 22 valid, AVX2 38 rows as 24 + 16 with 14).
+  const int L = dense::kLanes;
+  const int rows = 4 * L + 6, depth = 3;
   const Mat<float> w = Mat<float>::Random(rows, depth);
   std::vector<float> packed(dense::packedSize(rows, depth), -1.f);
-  ASSERT_EQ(packed.size(), size_t{80 * 3});
+  ASSERT_EQ(packed.size(), size_t(5 * L * 3));
   dense::pack(w.data(), rows, false, rows, depth, packed.data());
   for (int k = 0; k < depth; ++k) {
-    for (int r = 0; r < 48; ++r) EXPECT_EQ(packed[k * 48 + r], w(r, k));
-    for (int r = 0; r < 32; ++r) EXPECT_EQ(packed[48 * depth + k * 32 + r], r < 22 ? w(48 + r, k) : 0.f);
+    for (int r = 0; r < 3 * L; ++r) EXPECT_EQ(packed[k * 3 * L + r], w(r, k));
+    for (int r = 0; r < 2 * L; ++r)
+      EXPECT_EQ(packed[3 * L * depth + k * 2 * L + r], r < L + 6 ? w(3 * L + r, k) : 0.f);
   }
 }
 
 // Threads that pack a part each (the fused backward's W^T) write together exactly the bytes of
 // one pack: every panel once, padding included, at 1 to 4 parts and shapes of 1 to 9 panels.
 TEST(DenseKernelsPack, PartsWriteTogetherWhatOnePackWrites) {
-  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512 or AVX2";
   for (const auto& [rows, depth] : {std::pair{7, 5}, std::pair{70, 3}, std::pair{400, 74}, std::pair{100, 200}}) {
     const Mat<float> w = Mat<float>::Random(depth, rows);  // transposed: W^T is rows x depth
     std::vector<float> whole(dense::packedSize(rows, depth), -1.f);
@@ -265,7 +295,7 @@ void expectFusedMatchesGeneric(const MlpShape& shape, int batch, int threads) {
 }
 
 TEST(MlpFusedEngine, MatchesTheGenericEngineInDoubleForTheHumanoidPolicy) {
-  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512 or AVX2";
   const MlpShape shape{74, {400, 200, 100}, 21, Activation::kElu, Activation::kIdentity};
   for (int batch : {1, 13, 300, 1000}) expectFusedMatchesGeneric(shape, batch, 2);
   expectFusedMatchesGeneric(shape, 777, 1);
@@ -275,7 +305,7 @@ TEST(MlpFusedEngine, MatchesTheGenericEngineInDoubleForTheHumanoidPolicy) {
 // unfrozen path; 5 columns and more the batch path; and nothing can write the weights any more,
 // so the packs cannot go stale.
 TEST(MlpFusedEngine, FrozenParametersInferWithTheSameBitsAndRefuseWrites) {
-  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512 or AVX2";
   ParameterSet<float> params;
   Mlp<float> net(params, "net", MlpShape{74, {400, 200, 100}, 21, Activation::kElu, Activation::kIdentity});
   Rng rng(3);
@@ -294,7 +324,7 @@ TEST(MlpFusedEngine, FrozenParametersInferWithTheSameBitsAndRefuseWrites) {
 }
 
 TEST(MlpFusedEngine, MatchesTheGenericEngineForOtherActivationsAndWidths) {
-  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512";
+  if (!dense::kAvailable) GTEST_SKIP() << "built without AVX-512 or AVX2";
   expectFusedMatchesGeneric(MlpShape{9, {33, 17}, 3, Activation::kTanh, Activation::kTanh}, 600, 2);
   expectFusedMatchesGeneric(MlpShape{5, {64}, 1, Activation::kRelu, Activation::kElu}, 530, 2);
   expectFusedMatchesGeneric(MlpShape{7, {}, 2, Activation::kElu, Activation::kIdentity}, 40, 2);
