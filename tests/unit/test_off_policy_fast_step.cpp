@@ -191,12 +191,16 @@ Td3Errors td3Errors(bool transpose_q_weight) {
   const double loss_f = fast.criticLoss(p.batch_f, rf), loss_d = reference.criticLoss(p.batch_d, rd);
   EXPECT_GT(p.q_d.params().grads().norm(), 1e-3);
   e.critic = worstTensor(p.q_f.params(), p.q_f.params().grads(), p.q_d.params(), p.q_d.params().grads());
-  if (!transpose_q_weight) EXPECT_NEAR(loss_f, loss_d, kTolerance * std::abs(loss_d));
+  if (!transpose_q_weight) {
+    EXPECT_NEAR(loss_f, loss_d, kTolerance * std::abs(loss_d));
+  }
   const double actor_f = fast.actorLoss(p.batch_f), actor_d = reference.actorLoss(p.batch_d);
   EXPECT_GT(p.policy_d.params().grads().norm(), 1e-3);
   e.actor = worstTensor(p.policy_f.params(), p.policy_f.params().grads(), p.policy_d.params(),
                         p.policy_d.params().grads());
-  if (!transpose_q_weight) EXPECT_NEAR(actor_f, actor_d, kTolerance * (1 + std::abs(actor_d)));
+  if (!transpose_q_weight) {
+    EXPECT_NEAR(actor_f, actor_d, kTolerance * (1 + std::abs(actor_d)));
+  }
   return e;
 }
 
