@@ -317,11 +317,17 @@ void copyPanel(const float* w, Index ldw, int valid_rows, int width, int depth, 
   }
 }
 
-// The calling thread's panel buffer, grown to the widest panel seen (then never again).
+// The calling thread's panel buffer: a fixed one for depths up to 1024 (96 KiB per thread), so that
+// a training step never allocates; a growing one would, whenever the forward's dynamic schedule
+// first handed a thread a chunk (MlpAllocation.NoneForTheHumanoidPolicyFromActorToMinibatchSizes
+// failed 1 run in 15 so). Deeper layers grow a buffer of their own once per thread.
 float* panelBuffer(Index floats) {
-  thread_local std::vector<float> buffer;
-  if (static_cast<Index>(buffer.size()) < floats) buffer.resize(floats);
-  return buffer.data();
+  constexpr Index kFixedFloats = 3 * kLanes * 1024;
+  alignas(64) thread_local float fixed[kFixedFloats];
+  if (floats <= kFixedFloats) return fixed;
+  thread_local std::vector<float> grown;
+  if (static_cast<Index>(grown.size()) < floats) grown.resize(floats);
+  return grown.data();
 }
 
 // Panels outer, column tiles inner: a panel of W (24 rows x depth, 24 KiB at depth 256), copied

@@ -30,7 +30,7 @@
 namespace masa::sac {
 namespace {
 
-constexpr double kTolerance = 2e-5;  // relative to each tensor's norm (see the header)
+constexpr double kFastStepTolerance = 2e-5;  // relative to each tensor's norm (see the header)
 constexpr int kBatch = 256;
 
 const sym::SymmetrySpec& trifinger() {
@@ -121,8 +121,8 @@ TEST(OffPolicyFastStep, TwinActionGradientsMatchTheDoubleGenericEngine) {
   Mat<double> da_d(act, kBatch);
   MatRef<double> da_d_ref(da_d);
   qd.backward(dq.cast<double>(), &da_d_ref);
-  EXPECT_LT(relativeError(values, values_d), kTolerance);
-  EXPECT_LT(relativeError(da, da_d), kTolerance);
+  EXPECT_LT(relativeError(values, values_d), kFastStepTolerance);
+  EXPECT_LT(relativeError(da, da_d), kFastStepTolerance);
   EXPECT_GT(da_d.norm(), 1e-3);
 }
 
@@ -192,30 +192,30 @@ Td3Errors td3Errors(bool transpose_q_weight) {
   EXPECT_GT(p.q_d.params().grads().norm(), 1e-3);
   e.critic = worstTensor(p.q_f.params(), p.q_f.params().grads(), p.q_d.params(), p.q_d.params().grads());
   if (!transpose_q_weight) {
-    EXPECT_NEAR(loss_f, loss_d, kTolerance * std::abs(loss_d));
+    EXPECT_NEAR(loss_f, loss_d, kFastStepTolerance * std::abs(loss_d));
   }
   const double actor_f = fast.actorLoss(p.batch_f), actor_d = reference.actorLoss(p.batch_d);
   EXPECT_GT(p.policy_d.params().grads().norm(), 1e-3);
   e.actor = worstTensor(p.policy_f.params(), p.policy_f.params().grads(), p.policy_d.params(),
                         p.policy_d.params().grads());
   if (!transpose_q_weight) {
-    EXPECT_NEAR(actor_f, actor_d, kTolerance * (1 + std::abs(actor_d)));
+    EXPECT_NEAR(actor_f, actor_d, kFastStepTolerance * (1 + std::abs(actor_d)));
   }
   return e;
 }
 
 TEST(OffPolicyFastStep, Td3GradientsMatchTheDoubleGenericEngineTensorByTensor) {
   const Td3Errors e = td3Errors(false);
-  EXPECT_LT(e.critic.relative, kTolerance) << "critic, worst tensor " << e.critic.where;
-  EXPECT_LT(e.actor.relative, kTolerance) << "actor, worst tensor " << e.actor.where;
+  EXPECT_LT(e.critic.relative, kFastStepTolerance) << "critic, worst tensor " << e.critic.where;
+  EXPECT_LT(e.actor.relative, kFastStepTolerance) << "actor, worst tensor " << e.actor.where;
   std::cout << "float against double, worst tensor: critic " << e.critic.relative << " (" << e.critic.where
             << "), actor " << e.actor.relative << " (" << e.actor.where << ")\n";
 }
 
 TEST(OffPolicyFastStep, TheComparisonCatchesATransposedWeight) {
   const Td3Errors e = td3Errors(true);
-  EXPECT_GT(e.critic.relative, 100 * kTolerance) << "a transposed Q weight went unnoticed by the critic";
-  EXPECT_GT(e.actor.relative, 100 * kTolerance) << "a transposed Q weight went unnoticed by the actor";
+  EXPECT_GT(e.critic.relative, 100 * kFastStepTolerance) << "a transposed Q weight went unnoticed by the critic";
+  EXPECT_GT(e.actor.relative, 100 * kFastStepTolerance) << "a transposed Q weight went unnoticed by the actor";
 }
 
 }  // namespace
