@@ -319,7 +319,13 @@ void Learner::run(int64_t max_updates, const std::atomic<bool>* stop) {
   renderLearningCurve();
 }
 
-bool Learner::renderLearningCurve() { return curve_ && curve_->renderAndWait(); }
+bool Learner::renderLearningCurve() { return curve_ && curveHasData() && curve_->renderAndWait(); }
+
+bool Learner::curveHasData() const {
+  // gnuplot stops at a panel whose every point is NaN: no return before an episode ended, no mean
+  // Q before the off-policy learner's first gradient step (a resumed run's CSV has its history).
+  return (opt_.resume || report_.last_episodes_update > 0) && (!off_policy_ || off_policy_->gradientSteps() > 0);
+}
 
 void Learner::optimizePpo() {
   trainer_->prepare(*buffer_);
@@ -441,7 +447,7 @@ void Learner::report() {
                                                                        columns_.term_names, has_success_, false)})
                  : std::make_unique<LearningCurve>(dir_, rc_.task + " / " + model::methodName(rc_.method),
                                                    columns_.term_names, has_success_);
-  if (rc_.runner.plot_every > 0 && updates_ % rc_.runner.plot_every == 0) curve_->renderAsync();
+  if (rc_.runner.plot_every > 0 && updates_ % rc_.runner.plot_every == 0 && curveHasData()) curve_->renderAsync();
   if (opt_.verbose) printProgress(report_, columns_, max_updates_, update_interval_s_, rc_.runner.eval_episodes);
 }
 

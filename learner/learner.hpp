@@ -149,6 +149,7 @@ class Learner {
   void checkRanksAgree();
   // Tells the update: the stats message, metrics.csv, the curve, the progress line.
   void report();
+  bool curveHasData() const;  // every panel of the learning curve has a point to draw
   void openEventFile();  // rank 0: the run's TensorBoard event file, with the config as text
   void loadCheckpoint();
   void evaluate();
