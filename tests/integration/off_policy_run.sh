@@ -41,8 +41,11 @@ awk -F, -v starts=$starts -v ups=$ups '
     before = owed }' "$run/off_policy.csv" > "$work/verdict.txt"
 [ "$(wc -l < "$run/off_policy.csv")" -eq $((rounds + 1)) ] || fail "off_policy.csv has $(wc -l < "$run/off_policy.csv") lines"
 awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) col[$c] = c; next }
-  { r[NR - 1] = $col["return"] }
-  END { for (n = 5; n <= 12; n++) early += r[n] / 8; for (n = NR - 8; n < NR; n++) late += r[n] / 8
+  # A round in which no episode ended has return nan: the last 8 rounds that have one (a policy
+  # that stands to the time limit ends none for many rounds; the average was nan and failed).
+  $col["return"] != "nan" { r[++k] = $col["return"]; at[k] = NR - 1 }
+  END { for (i = 1; i <= k; i++) if (at[i] >= 5 && at[i] <= 12) { early += r[i]; ne++ }
+        early /= ne; for (i = k - 7; i <= k; i++) late += r[i] / 8
         printf "training return: rounds 5-12 %.1f, last 8 %.1f\n", early, late
         if (!(late >= 2 * early && late > 20)) print "FAIL: it did not learn" }' "$run/metrics.csv" | tee -a "$work/verdict.txt"
 grep -q FAIL "$work/verdict.txt" && fail "$(cat "$work/verdict.txt")"
