@@ -511,9 +511,12 @@ void Learner::writeCheckpoint() {
   rng_text << rng_;
   s.rng_state = rng_text.str();
   s.order = trainer_->shuffleOrder();
-  // The off-policy state first: checkpoint.bin, written last, says which update both are of.
-  if (off_policy_) writeOffPolicyState();
+  // Two files, no common atomic write: the off-policy state goes beside the old one (next), then
+  // checkpoint.bin, then the next state takes the old one's name. A stop between any two steps
+  // leaves a pair of the same update (readOffPolicyState sorts out which).
+  if (off_policy_) writeOffPolicyState(offPolicyStatePath(true));
   learner::writeCheckpoint((fs::path(dir_) / "checkpoint.bin").string(), s, *model_, *adam_);
+  if (off_policy_) fs::rename(offPolicyStatePath(true), offPolicyStatePath(false));
   // What inference needs, for evaluation and deployment (masa_eval, the robot runner).
   if (off_policy_) off_policy_->savePolicyFile((fs::path(dir_) / "policy.bin").string());
   else policy::savePolicyFile((fs::path(dir_) / "policy.bin").string(), rc_, *model_);
@@ -560,9 +563,13 @@ namespace {
 const integrity::FileKind kOffPolicyStateKind{"masa off-policy learner state", "MASAOFF1"};
 }
 
-void Learner::writeOffPolicyState() {
+std::string Learner::offPolicyStatePath(bool next) const {
+  return (fs::path(dir_) / (next ? "off_policy_state.next.bin" : "off_policy_state.bin")).string();
+}
+
+void Learner::writeOffPolicyState(const std::string& path) {
   // Streamed: the replay (most of a gigabyte) goes to the disk as it is hashed, never copied whole.
-  integrity::writeSealedFileStreamed((fs::path(dir_) / "off_policy_state.bin").string(), kOffPolicyStateKind, [&](std::ostream& os) {
+  integrity::writeSealedFileStreamed(path, kOffPolicyStateKind, [&](std::ostream& os) {
     io::writePod(os, updates_);
     off_policy_->save(os);
   });
@@ -585,10 +592,30 @@ void Learner::appendOffPolicyRow(double lag_mean, int64_t lag_max) {
 }
 
 void Learner::readOffPolicyState() {
-  const std::string path = (fs::path(dir_) / "off_policy_state.bin").string();
-  std::istringstream is(integrity::readSealedFile(path, kOffPolicyStateKind).payload);
+  // A next state is left by a stop inside writeCheckpoint: it is the one to go on from when
+  // checkpoint.bin got to its update too, and a stale one otherwise (the stop fell before
+  // checkpoint.bin was replaced).
+  const std::string next = offPolicyStatePath(true);
+  std::string path = offPolicyStatePath(false);
+  std::istringstream is;
   int64_t updates = -1;
-  if (!io::readPod(is, updates)) throw std::runtime_error(path + ": truncated");
+  if (fs::exists(next)) {
+    is.str(integrity::readSealedFile(next, kOffPolicyStateKind).payload);
+    if (!io::readPod(is, updates)) throw std::runtime_error(next + ": truncated");
+    if (updates == updates_) {
+      fs::rename(next, path);
+    } else {
+      std::fprintf(stderr, "masa_train: %s is of update %lld, checkpoint.bin of %lld: a stop fell before the checkpoint was written; going on from %s\n",
+                   next.c_str(), static_cast<long long>(updates), static_cast<long long>(updates_), path.c_str());
+      fs::remove(next);
+      updates = -1;
+    }
+  }
+  if (updates == -1) {
+    is.str(integrity::readSealedFile(path, kOffPolicyStateKind).payload);
+    is.clear();
+    if (!io::readPod(is, updates)) throw std::runtime_error(path + ": truncated");
+  }
   if (updates != updates_)
     throw std::runtime_error("resume: " + path + " is of update " + std::to_string(updates) + ", checkpoint.bin of " +
                              std::to_string(updates_) + " (stopped while writing them?)");

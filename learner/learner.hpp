@@ -139,8 +139,10 @@ class Learner {
   void update();
   void optimizePpo();  // PPO's passes over the batch in buffer_
   void fillPpoParams(masa::lcmt_policy_params& m) const;
-  // learner: off_policy's state beside checkpoint.bin (off_policy_state.bin, sealed).
-  void writeOffPolicyState();
+  // learner: off_policy's state beside checkpoint.bin (off_policy_state.bin, sealed; written as
+  // off_policy_state.next.bin until checkpoint.bin is).
+  std::string offPolicyStatePath(bool next) const;
+  void writeOffPolicyState(const std::string& path);
   void readOffPolicyState();
   // A row of off_policy.csv: the update, env steps, the policy lag of the batch (in updates: mean,
   // max) and the algorithm's figures of the round.

@@ -16,6 +16,7 @@ tiny=("${task[@]}" --set learner=off_policy --set ppo.num_envs=8 --set ppo.horiz
 "${train[@]}" --updates 12 --run-dir whole "${tiny[@]}" > whole.log 2>&1 || fail "the whole run failed"
 "${train[@]}" --updates 5 --run-dir parts "${tiny[@]}" > parts1.log 2>&1 || fail "the first part failed"
 [ -s parts/off_policy_state.bin ] || fail "no off_policy_state.bin beside the checkpoint"
+cp -r parts at5
 "${train[@]}" --updates 12 --resume parts > parts2.log 2>&1 || fail "the resume failed: $(tail -n 2 parts2.log)"
 cmp -s <(strip whole/metrics.csv) <(strip parts/metrics.csv) || fail "metrics.csv differs: $(diff <(strip whole/metrics.csv) <(strip parts/metrics.csv) | head -4)"
 cmp -s whole/off_policy.csv parts/off_policy.csv || fail "off_policy.csv differs: $(diff whole/off_policy.csv parts/off_policy.csv | head -4)"
@@ -25,8 +26,20 @@ if [ "${3:-}" = her ]; then
   share=$(awk -F, 'NR == 1 { for (c = 1; c <= NF; c++) if ($c == "relabeled_share") col = c; next } END { print $col }' whole/off_policy.csv)
   awk -v s="$share" 'BEGIN { exit !(s >= 0.5 && s <= 1.0) }' || fail "the last round relabeled a share of $share, not about 0.8"
 fi
+# A stop inside the checkpoint's writing: the off-policy state goes to off_policy_state.next.bin,
+# then checkpoint.bin, then the next state takes the old one's name. Either stop point goes on as
+# the run never stopped (before, a stop between the two files left a pair no resume accepted).
+cp -r at5 ahead && "${train[@]}" --updates 6 --resume ahead > ahead.log 2>&1 || fail "the run to 6 failed"
+cp -r at5 stop_before && cp ahead/off_policy_state.bin stop_before/off_policy_state.next.bin
+cp -r ahead stop_after && cp ahead/off_policy_state.bin stop_after/off_policy_state.next.bin && cp at5/off_policy_state.bin stop_after/
+for stop in stop_before stop_after; do
+  "${train[@]}" --updates 12 --resume $stop > $stop.log 2>&1 || fail "$stop: the resume failed: $(tail -n 2 $stop.log)"
+  cmp -s whole/off_policy.csv $stop/off_policy.csv || fail "$stop: off_policy.csv differs: $(diff whole/off_policy.csv $stop/off_policy.csv | head -4)"
+  [ ! -e $stop/off_policy_state.next.bin ] || fail "$stop: the next state is still there"
+done
+grep -q "a stop fell before the checkpoint" stop_before.log || fail "the stale next state went unreported: $(tail -n 2 stop_before.log)"
 # The state is sealed: a flipped byte is refused by name, nothing is resumed from it.
 cp -r parts damaged && printf '\xff' | dd of=damaged/off_policy_state.bin bs=1 seek=200 conv=notrunc status=none
 if "${train[@]}" --updates 14 --resume damaged > damaged.log 2>&1; then fail "a damaged off_policy_state.bin was resumed"; fi
 grep -q "off_policy_state.bin" damaged.log || fail "the refusal does not name the file: $(tail -n 2 damaged.log)"
-echo "PASS: resumed at 5, bit for bit the run never stopped to 12 ($steps gradient steps); a damaged state refused by name"
+echo "PASS: resumed at 5, bit for bit the run never stopped to 12 ($steps gradient steps); a stop between its two files at either point goes on the same; a damaged state refused by name"
