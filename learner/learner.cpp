@@ -32,19 +32,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// RunningMeanStd's default epsilon: the broadcast std is sqrt(var + eps), what the learner divides by.
-constexpr double kObsEps = 1e-5;
-
 // An actor counts as live for the parameter repeats this long after it was last heard: three of its
 // heartbeats (one a second). A dead actor costs the repeats of these seconds, then none.
 constexpr double kActorLiveS = 3.0;
 
-
-model::ModelConfig modelConfigOf(const config::RunConfig& rc) {
-  model::ModelConfig m = rc.model;
-  m.method = rc.method;  // the run's method is authoritative
-  return m;
-}
 
 int64_t randomRunId() {
   // Clock-derived and mixed, so two learners started in the same second still differ.
@@ -86,22 +77,13 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   if (isLeadRank() && !opt_.resume) refuseRunDirInUse(dir_);
   if (isLeadRank()) fs::create_directories(dir_);
   const auto spec = sym::SymmetrySpec::load(rc_.spec_path);
-  model_ = std::make_unique<model::ActorCritic<float>>(spec, modelConfigOf(rc_));
-  model_->initialize(rng_);
-  nn::AdamConfig<float> adam_cfg;
-  adam_cfg.lr = static_cast<float>(rc_.ppo.learning_rate);
-  adam_ = std::make_unique<nn::Adam<float>>(model_->params(), adam_cfg);
-  if (rc_.learner == "off_policy") {
-    MASA_CHECK(opt_.make_off_policy, "learner: off_policy is not built into this program (masa_learner and masa_train run it)");
-    MASA_CHECK(ranks_->size() == 1, "learner: off_policy runs on one learner rank (" << ranks_->size() << " given)");
-    off_policy_ = opt_.make_off_policy(rc_, rng_);
-  }
-  const int64_t batch_samples = static_cast<int64_t>(rc_.ppo.num_envs) * rc_.ppo.horizon;
-  MASA_CHECK(off_policy_ || batch_samples % rc_.ppo.minibatch_size == 0,
-             "ppo.minibatch_size " << rc_.ppo.minibatch_size << " must divide the batch, ppo.num_envs x ppo.horizon = "
-                                   << batch_samples);
-  trainer_ = std::make_unique<ppo::PpoTrainer>(*model_, *adam_, rc_.ppo, *ranks_);
-  buffer_ = std::make_unique<ppo::RolloutBuffer>(rank_envs_, rc_.ppo.horizon, model_->obsDim(), model_->actDim());
+  obs_dim_ = spec.obsDim();
+  act_dim_ = spec.actDim();
+  MASA_CHECK(opt_.make_algorithm, "learner: no algorithm given (LearnerOptions::make_algorithm)");
+  algorithm_ = opt_.make_algorithm(rc_, rng_, *ranks_);
+  MASA_CHECK(ranks_->size() == 1 || algorithm_->dataParallel(),
+             "learner: " << rc_.learner << " runs on one learner rank (" << ranks_->size() << " given)");
+  buffer_ = std::make_unique<ppo::RolloutBuffer>(rank_envs_, rc_.ppo.horizon, obs_dim_, act_dim_);
 
   run_id_ = options.run_id;
   if (opt_.resume) loadCheckpoint();  // sets run_id_ unless one was given
@@ -122,7 +104,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   const auto probe = factory->create();
   columns_.term_names = probe->rewardTermNames();
   assembler_ = std::make_unique<RolloutAssembler>(
-      assemblerConfig(run_id_, rc_, model_->obsDim(), model_->actDim(), columns_.term_names));
+      assemblerConfig(run_id_, rc_, obs_dim_, act_dim_, columns_.term_names));
   assembler_->setLearnerVersion(updates_);
 
   const std::string intake_url = opt_.rollout_url.empty() ? opt_.url : opt_.rollout_url;
@@ -165,8 +147,7 @@ void Learner::evaluate() {
   o.seed = 1000000;
   o.deterministic = true;
   o.threads = omp_get_max_threads();
-  const auto off_policy_model = off_policy_ ? off_policy_->evaluationModel() : nullptr;
-  task::PolicyEvaluator evaluator(*eval_factory_, off_policy_model ? *off_policy_model : *model_);
+  task::PolicyEvaluator evaluator(*eval_factory_, algorithm_->evaluationModel());
   const task::EvalSummary s = evaluator.run(o);
   report_.eval_return = s.ret.mean;
   report_.eval_length = s.length.mean;
@@ -216,8 +197,8 @@ void Learner::onChunk(const Verdict& v) {
     CollectorConfig c;
     c.num_envs = rank_envs_;
     c.horizon = rc_.ppo.horizon;
-    c.obs_dim = model_->obsDim();
-    c.act_dim = model_->actDim();
+    c.obs_dim = obs_dim_;
+    c.act_dim = act_dim_;
     c.max_policy_lag = rc_.ppo.max_policy_lag;
     c.term_names = columns_.term_names;  // the task's: the assembler dropped chunks naming others
     collector_ = std::make_unique<BatchCollector>(c);
@@ -324,17 +305,7 @@ bool Learner::renderLearningCurve() { return curve_ && curveHasData() && curve_-
 bool Learner::curveHasData() const {
   // gnuplot stops at a panel whose every point is NaN: no return before an episode ended, no mean
   // Q before the off-policy learner's first gradient step (a resumed run's CSV has its history).
-  return (opt_.resume || report_.last_episodes_update > 0) && (!off_policy_ || off_policy_->gradientSteps() > 0);
-}
-
-void Learner::optimizePpo() {
-  trainer_->prepare(*buffer_);
-  if (!restored_order_.empty()) {
-    // A resumed run continues the shuffle of the run it resumes (see PpoTrainer::shuffleOrder).
-    if (restored_order_.size() == trainer_->shuffleOrder().size()) trainer_->shuffleOrder() = restored_order_;
-    restored_order_.clear();
-  }
-  report_.ppo = trainer_->optimize(*buffer_, rng_);
+  return (opt_.resume || report_.last_episodes_update > 0) && algorithm_->curveHasData();
 }
 
 void Learner::update() {
@@ -357,16 +328,12 @@ void Learner::update() {
     lag_mean += static_cast<double>(updates_ - v) / static_cast<double>(origin_.env_version.size());
     lag_max = std::max(lag_max, updates_ - v);
   }
-  if (off_policy_) {
-    // An environment's stream: its actor and its index there (ids below 2^32 each).
-    env_streams_.resize(origin_.env_actor.size());
-    for (std::size_t e = 0; e < env_streams_.size(); ++e)
-      env_streams_[e] = (static_cast<int64_t>(origin_.env_actor[e]) << 32) | static_cast<uint32_t>(origin_.env_index[e]);
-    report_.ppo = off_policy_->learn(buffer_->data(), env_streams_, rng_);
-    report_.algorithm_figures = offPolicyProgressFigures(off_policy_->roundFigures());
-  } else {
-    optimizePpo();
-  }
+  // An environment's stream: its actor and its index there (ids below 2^32 each).
+  env_streams_.resize(origin_.env_actor.size());
+  for (std::size_t e = 0; e < env_streams_.size(); ++e)
+    env_streams_[e] = (static_cast<int64_t>(origin_.env_actor[e]) << 32) | static_cast<uint32_t>(origin_.env_index[e]);
+  report_.learned = algorithm_->learn(*buffer_, env_streams_, rng_);
+  report_.algorithm_figures = algorithm_->progressFigures(report_.learned);
 
   const auto now = std::chrono::steady_clock::now();
   report_.learn_s = std::chrono::duration<double>(now - began).count();
@@ -401,9 +368,9 @@ void Learner::update() {
   if (!isLeadRank()) return;  // rank 0 speaks for the ranks and keeps the run directory
   publishParams();
   report();
-  if (off_policy_) {
-    appendOffPolicyRow(lag_mean, lag_max);
-    off_policy_events_->mirrorLastRow();
+  if (round_events_) {
+    appendRoundRow(lag_mean, lag_max);
+    round_events_->mirrorLastRow();
   }
   if (rc_.runner.checkpoint_every > 0 && updates_ % rc_.runner.checkpoint_every == 0) writeCheckpoint();
   if (rc_.runner.snapshot_every > 0 && updates_ % rc_.runner.snapshot_every == 0) writeSnapshot();
@@ -414,22 +381,13 @@ void Learner::openEventFile() {
   // The configuration as text, at the step the run (re)starts from: a resume's overrides show.
   events_->text("config", env_steps_, preformatted(config::dumpResolved(rc_)));
   metrics_events_ = std::make_unique<CsvEvents>(*events_, (fs::path(dir_) / "metrics.csv").string(), "env_steps", "learn");
-  if (off_policy_)
-    off_policy_events_ =
-        std::make_unique<CsvEvents>(*events_, (fs::path(dir_) / "off_policy.csv").string(), "env_steps", "off_policy",
-                                    std::vector<std::string>{"update"});
+  if (const std::string table = algorithm_->roundTable(); !table.empty())
+    round_events_ = std::make_unique<CsvEvents>(*events_, (fs::path(dir_) / table).string(), "env_steps",
+                                                fs::path(table).stem().string(), std::vector<std::string>{"update"});
 }
 
 void Learner::checkRanksAgree() {
-  const auto& p = model_->params().values();
-  uint64_t h = cluster::hashBytes(p.data(), sizeof(float) * static_cast<std::size_t>(p.size()));
-  for (const auto* norm : {&model_->obsNormalizer(), &model_->valueNormalizer()}) {
-    h = cluster::hashBytes(norm->mean().data(), sizeof(double) * static_cast<std::size_t>(norm->dim()), h);
-    h = cluster::hashBytes(norm->var().data(), sizeof(double) * static_cast<std::size_t>(norm->dim()), h);
-  }
-  const double lr = trainer_->learningRate().lr();
-  h = cluster::hashBytes(&lr, sizeof lr, h);
-  cluster::requireSameOnEveryRank(*ranks_, h, "parameters, normalizers or learning rate after update " +
+  cluster::requireSameOnEveryRank(*ranks_, algorithm_->agreementHash(), "parameters, normalizers or learning rate after update " +
                                                  std::to_string(updates_));
 }
 
@@ -440,13 +398,9 @@ void Learner::report() {
   appendMetricsRow((fs::path(dir_) / "metrics.csv").string(), report_, columns_);
   metrics_events_->mirrorLastRow();
   if (!curve_)
-    curve_ = off_policy_
-                 ? std::make_unique<LearningCurve>(
-                       dir_, LearningCurve::Script{learningCurveScript(rc_.task + " / " + model::methodName(rc_.method) +
-                                                                           " (off-policy)",
-                                                                       columns_.term_names, has_success_, false)})
-                 : std::make_unique<LearningCurve>(dir_, rc_.task + " / " + model::methodName(rc_.method),
-                                                   columns_.term_names, has_success_);
+    curve_ = std::make_unique<LearningCurve>(
+        dir_, LearningCurve::Script{algorithm_->curveScript(rc_.task + " / " + model::methodName(rc_.method),
+                                                            columns_.term_names, has_success_)});
   if (rc_.runner.plot_every > 0 && updates_ % rc_.runner.plot_every == 0 && curveHasData()) curve_->renderAsync();
   if (opt_.verbose) printProgress(report_, columns_, max_updates_, update_interval_s_, rc_.runner.eval_episodes);
 }
@@ -458,8 +412,7 @@ void Learner::writeSnapshot() {
   fs::create_directories(dir);
   char name[32];
   std::snprintf(name, sizeof name, "policy_u%06lld.bin", static_cast<long long>(updates_));
-  if (off_policy_) off_policy_->savePolicyFile((dir / name).string());
-  else policy::savePolicyFile((dir / name).string(), rc_, *model_);
+  algorithm_->savePolicyFile((dir / name).string());
 }
 
 void Learner::publishParams() {
@@ -469,33 +422,10 @@ void Learner::publishParams() {
   m.version = updates_;
   m.method = model::methodName(rc_.method);
   m.task = rc_.task;
-  if (off_policy_) {
-    off_policy_->fillPolicyMessage(m);
-  } else {
-    fillPpoParams(m);
-  }
+  algorithm_->fillPolicyMessage(m);
   publisher().publish(transport::kPolicyChannel, m);
   last_publish_ = std::chrono::steady_clock::now();
   delivery_.published(m.version, last_publish_);
-}
-
-void Learner::fillPpoParams(masa::lcmt_policy_params& m) const {
-  // The policy prefix only: the critic is the learner's business, and it halves the broadcast.
-  const auto& p = model_->params().values();
-  m.num_params = model_->policyParamCount();
-  m.params.assign(p.data(), p.data() + m.num_params);
-  if (model_->config().normalize_obs) {
-    auto& norm = model_->obsNormalizer();
-    m.obs_dim = norm.dim();
-    m.obs_mean.resize(norm.dim());
-    m.obs_std.resize(norm.dim());
-    for (int d = 0; d < norm.dim(); ++d) {
-      m.obs_mean[d] = static_cast<float>(norm.mean()(d));
-      m.obs_std[d] = static_cast<float>(std::sqrt(norm.var()(d) + kObsEps));
-    }
-  } else {
-    m.obs_dim = 0;
-  }
 }
 
 void Learner::writeCheckpoint() {
@@ -506,20 +436,22 @@ void Learner::writeCheckpoint() {
   s.version = updates_;
   s.env_steps = env_steps_;
   s.wall_time_s = wallTime();
-  s.lr = trainer_->learningRate().lr();
   std::ostringstream rng_text;
   rng_text << rng_;
   s.rng_state = rng_text.str();
-  s.order = trainer_->shuffleOrder();
-  // Two files, no common atomic write: the off-policy state goes beside the old one (next), then
+  s.kind = algorithm_->kind();
+  std::ostringstream body(std::ios::binary);
+  algorithm_->saveCheckpointBody(body);
+  s.body = std::move(body).str();
+  // Two files, no common atomic write: the side state goes beside the old one (next), then
   // checkpoint.bin, then the next state takes the old one's name. A stop between any two steps
-  // leaves a pair of the same update (readOffPolicyState sorts out which).
-  if (off_policy_) writeOffPolicyState(offPolicyStatePath(true));
-  learner::writeCheckpoint((fs::path(dir_) / "checkpoint.bin").string(), s, *model_, *adam_);
-  if (off_policy_) fs::rename(offPolicyStatePath(true), offPolicyStatePath(false));
+  // leaves a pair of the same update (readSideState sorts out which).
+  const bool side = algorithm_->sideState().has_value();
+  if (side) writeSideState(sideStatePath(true));
+  learner::writeCheckpoint((fs::path(dir_) / "checkpoint.bin").string(), s);
+  if (side) fs::rename(sideStatePath(true), sideStatePath(false));
   // What inference needs, for evaluation and deployment (masa_eval, the robot runner).
-  if (off_policy_) off_policy_->savePolicyFile((fs::path(dir_) / "policy.bin").string());
-  else policy::savePolicyFile((fs::path(dir_) / "policy.bin").string(), rc_, *model_);
+  algorithm_->savePolicyFile((fs::path(dir_) / "policy.bin").string());
   if (checkpoint_hook_) checkpoint_hook_(updates_);
 }
 
@@ -527,7 +459,7 @@ void Learner::loadCheckpoint() {
   const std::string path = (fs::path(dir_) / "checkpoint.bin").string();
   CheckpointState s;
   if (ranks_->size() == 1) {
-    s = readCheckpoint(path, *model_, adam_.get());
+    s = readCheckpoint(path);
   } else {
     // Rank 0's file for every rank: the ranks need not share a file system.
     std::vector<uint8_t> bytes;
@@ -537,49 +469,55 @@ void Learner::loadCheckpoint() {
       bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     ranks_->broadcast(bytes, 0);
-    s = readCheckpointBytes(std::string(bytes.begin(), bytes.end()), path + " (rank 0's)", *model_, adam_.get());
+    s = readCheckpointBytes(std::string(bytes.begin(), bytes.end()), path + " (rank 0's)");
   }
   if (run_id_ == 0) run_id_ = s.run_id;  // keep the run: its actors go on being accepted
   if (s.version != s.updates)
     throw std::runtime_error("resume: " + dir_ + "/checkpoint.bin has policy version " + std::to_string(s.version) +
                              " after " + std::to_string(s.updates) + " updates; they are one count");
+  // A version 1 checkpoint held a PPO body in every run; an off-policy run never used it.
+  const bool unused_legacy_body = s.legacy && s.kind != algorithm_->kind();
+  if (s.kind != algorithm_->kind() && !unused_legacy_body)
+    throw std::runtime_error("resume: " + path + " is of a run with learner: " + s.kind + "; this run's learner is " +
+                             algorithm_->kind());
   updates_ = s.updates;
   env_steps_ = s.env_steps;
   wall_offset_s_ = s.wall_time_s;
   std::istringstream rng_text(s.rng_state);
   rng_text >> rng_;
   if (!rng_text) throw std::runtime_error("resume: corrupt rng state in " + dir_ + "/checkpoint.bin");
-  restored_order_ = s.order;
+  if (!unused_legacy_body) {
+    std::istringstream body(s.body, std::ios::binary);
+    algorithm_->loadCheckpointBody(body, path);
+  }
   if (isLeadRank()) {
     truncateMetricsCsv((fs::path(dir_) / "metrics.csv").string(), s.updates);  // rows past the checkpoint come again
     truncateEventFile((fs::path(dir_) / EventFile::kFileName).string(), s.env_steps);  // and their events
   }
-  trainer_->learningRate().setLr(s.lr);
-  adam_->config().lr = static_cast<float>(s.lr);
-  if (off_policy_) readOffPolicyState();
+  if (algorithm_->sideState()) readSideState();
+  if (const std::string table = algorithm_->roundTable(); !table.empty() && isLeadRank())
+    truncateMetricsCsv((fs::path(dir_) / table).string(), updates_);  // rows past the checkpoint come again
 }
 
-namespace {
-const integrity::FileKind kOffPolicyStateKind{"masa off-policy learner state", "MASAOFF1"};
+std::string Learner::sideStatePath(bool next) const {
+  fs::path name = algorithm_->sideState()->name;
+  if (next) name = name.stem().string() + ".next" + name.extension().string();
+  return (fs::path(dir_) / name).string();
 }
 
-std::string Learner::offPolicyStatePath(bool next) const {
-  return (fs::path(dir_) / (next ? "off_policy_state.next.bin" : "off_policy_state.bin")).string();
-}
-
-void Learner::writeOffPolicyState(const std::string& path) {
-  // Streamed: the replay (most of a gigabyte) goes to the disk as it is hashed, never copied whole.
-  integrity::writeSealedFileStreamed(path, kOffPolicyStateKind, [&](std::ostream& os) {
+void Learner::writeSideState(const std::string& path) {
+  // Streamed: a replay (most of a gigabyte) goes to the disk as it is hashed, never copied whole.
+  integrity::writeSealedFileStreamed(path, algorithm_->sideState()->kind, [&](std::ostream& os) {
     io::writePod(os, updates_);
-    off_policy_->save(os);
+    algorithm_->saveSideState(os);
   });
 }
 
-void Learner::appendOffPolicyRow(double lag_mean, int64_t lag_max) {
-  const fs::path path = fs::path(dir_) / "off_policy.csv";
+void Learner::appendRoundRow(double lag_mean, int64_t lag_max) {
+  const fs::path path = fs::path(dir_) / algorithm_->roundTable();
   const bool fresh = !fs::exists(path) || fs::file_size(path) == 0;
   std::ofstream f(path, std::ios::app);
-  const auto figures = off_policy_->roundFigures();
+  const auto figures = algorithm_->roundFigures();
   if (fresh) {
     f << "update,env_steps,policy_lag_mean,policy_lag_max";
     for (const auto& [name, value] : figures) f << ',' << name;
@@ -591,16 +529,17 @@ void Learner::appendOffPolicyRow(double lag_mean, int64_t lag_max) {
   f << '\n';
 }
 
-void Learner::readOffPolicyState() {
+void Learner::readSideState() {
   // A next state is left by a stop inside writeCheckpoint: it is the one to go on from when
   // checkpoint.bin got to its update too, and a stale one otherwise (the stop fell before
   // checkpoint.bin was replaced).
-  const std::string next = offPolicyStatePath(true);
-  std::string path = offPolicyStatePath(false);
+  const integrity::FileKind kind = algorithm_->sideState()->kind;
+  const std::string next = sideStatePath(true);
+  const std::string path = sideStatePath(false);
   std::istringstream is;
   int64_t updates = -1;
   if (fs::exists(next)) {
-    is.str(integrity::readSealedFile(next, kOffPolicyStateKind).payload);
+    is.str(integrity::readSealedFile(next, kind).payload);
     if (!io::readPod(is, updates)) throw std::runtime_error(next + ": truncated");
     if (updates == updates_) {
       fs::rename(next, path);
@@ -612,15 +551,14 @@ void Learner::readOffPolicyState() {
     }
   }
   if (updates == -1) {
-    is.str(integrity::readSealedFile(path, kOffPolicyStateKind).payload);
+    is.str(integrity::readSealedFile(path, kind).payload);
     is.clear();
     if (!io::readPod(is, updates)) throw std::runtime_error(path + ": truncated");
   }
   if (updates != updates_)
     throw std::runtime_error("resume: " + path + " is of update " + std::to_string(updates) + ", checkpoint.bin of " +
                              std::to_string(updates_) + " (stopped while writing them?)");
-  off_policy_->load(is, path);
-  truncateMetricsCsv((fs::path(dir_) / "off_policy.csv").string(), updates_);  // rows past the checkpoint come again
+  algorithm_->loadSideState(is, path);
 }
 
 }  // namespace masa::learner

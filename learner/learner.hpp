@@ -1,5 +1,6 @@
-// The learner process: receives rollout chunks over LCM, gathers them into batches, runs one PPO
-// update per batch and broadcasts the new parameters.
+// The learner process: receives rollout chunks over LCM, gathers them into batches, has its
+// algorithm (learner/algorithm.hpp: PPO, or SAC/TD3 on a replay) learn from each, and broadcasts
+// the new parameters.
 //
 // Chunks take the raw path (RolloutAssembler::acceptEncoded) because lcm-gen's decoder trusts
 // hostile length fields. Nothing waits for a particular actor or chunk: the collector hands out a
@@ -7,8 +8,9 @@
 // re-published periodically so that a lost broadcast never stalls the actors.
 //
 // Run directory: config.yaml (resolved config), metrics.csv (one row per update, with an evaluation
-// of the policy mean every runner.eval_every updates), checkpoint.bin (learner state, to resume) and
-// policy.bin (what inference needs: masa_eval, deployment), both written atomically (tmp + rename).
+// of the policy mean every runner.eval_every updates), checkpoint.bin (learner state, to resume),
+// the algorithm's own files (its round table, its streamed state) and policy.bin (what inference
+// needs: masa_eval, deployment), each written atomically (tmp + rename).
 #pragma once
 
 #include <atomic>
@@ -23,8 +25,6 @@
 
 #include "common/cluster/communicator.hpp"
 #include "common/config/run_config.hpp"
-#include "common/model/actor_critic.hpp"
-#include "common/nn/adam.hpp"
 #include "common/sim/registry.hpp"
 #include "common/transport/message_bus.hpp"
 #include "common/transport/transport.hpp"
@@ -34,11 +34,11 @@
 #include "learner/csv_events.hpp"
 #include "learner/event_file.hpp"
 #include "learner/learning_curve.hpp"
-#include "learner/off_policy_learning.hpp"
 #include "learner/params_delivery.hpp"
 #include "learner/update_report.hpp"
-#include "learner/ppo/ppo_trainer.hpp"
+#include "learner/algorithm.hpp"
 #include "learner/ppo/rollout_buffer.hpp"
+#include "learner/ppo_algorithm.hpp"
 #include "learner/silence_watch.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 
@@ -64,10 +64,11 @@ struct LearnerOptions {
   cluster::Communicator* ranks = nullptr;
   std::string rollout_url;  // "" = url
   int rank_check_every = 10;
-  // Makes the algorithm of a run whose `learner` is off_policy (off_policy_learning.hpp), from the
-  // run config and the learner's seeded generator; masa_learner and masa_train pass
-  // learner/sac's. Unset: such a run is refused.
-  std::function<std::unique_ptr<OffPolicyLearning>(const config::RunConfig&, Rng&)> make_off_policy;
+  // Makes the run's algorithm from the run config, the learner's seeded generator and the ranks:
+  // masa_learner and masa_train pass learner/algorithms' catalog (every `learner` value); the
+  // default runs PPO and refuses the others.
+  std::function<std::unique_ptr<Algorithm>(const config::RunConfig&, Rng&, cluster::Communicator&)> make_algorithm =
+      makePpoAlgorithm;
   // In-process (masa_train): every channel on this bus (a transport::LocalBus: typed messages
   // handed over without encoding), owned by the caller; url, rollout_url and the keys are unused.
   // Null: the learner makes its LCM transports from url and rollout_url.
@@ -111,7 +112,7 @@ class Learner {
   int64_t version() const { return updates_; }
   int64_t envSteps() const { return env_steps_; }
   const std::string& runDir() const { return dir_; }
-  const model::ActorCritic<float>& model() const { return *model_; }
+  Algorithm& algorithm() { return *algorithm_; }
   // The assembler's counts, and the chunks the transport dropped for want of a valid tag.
   DropStats dropStats() const;
   // One unit each: rollout chunks the assembler dropped (or counted lost), and environments the
@@ -137,16 +138,14 @@ class Learner {
   // of the parameters comes due sooner.
   int waitMs(int timeout_ms) const;
   void update();
-  void optimizePpo();  // PPO's passes over the batch in buffer_
-  void fillPpoParams(masa::lcmt_policy_params& m) const;
-  // learner: off_policy's state beside checkpoint.bin (off_policy_state.bin, sealed; written as
-  // off_policy_state.next.bin until checkpoint.bin is).
-  std::string offPolicyStatePath(bool next) const;
-  void writeOffPolicyState(const std::string& path);
-  void readOffPolicyState();
-  // A row of off_policy.csv: the update, env steps, the policy lag of the batch (in updates: mean,
-  // max) and the algorithm's figures of the round.
-  void appendOffPolicyRow(double lag_mean, int64_t lag_max);
+  // The algorithm's streamed state beside checkpoint.bin (Algorithm::sideState, sealed; written
+  // under a "next" name until checkpoint.bin is).
+  std::string sideStatePath(bool next) const;
+  void writeSideState(const std::string& path);
+  void readSideState();
+  // A row of the algorithm's round table: the update, env steps, the policy lag of the batch (in
+  // updates: mean, max) and the algorithm's figures of the round.
+  void appendRoundRow(double lag_mean, int64_t lag_max);
   // Every rank's parameters, normalizers and learning rate hash the same, or RankDisagreement.
   void checkRanksAgree();
   // Tells the update: the stats message, metrics.csv, the curve, the progress line.
@@ -163,13 +162,11 @@ class Learner {
   int64_t run_id_ = 0;
 
   Rng rng_;
-  std::unique_ptr<model::ActorCritic<float>> model_;
-  std::unique_ptr<nn::Adam<float>> adam_;
-  std::unique_ptr<ppo::PpoTrainer> trainer_;
-  std::unique_ptr<ppo::RolloutBuffer> buffer_;
-  std::unique_ptr<OffPolicyLearning> off_policy_;  // learner: off_policy (then PPO's trainer idles)
+  int obs_dim_ = 0, act_dim_ = 0;  // the task's (its symmetry spec's)
+  std::unique_ptr<Algorithm> algorithm_;
+  std::unique_ptr<ppo::RolloutBuffer> buffer_;  // the batch
   BatchOrigin origin_;  // where the batch's environments came from: their policy versions (the lag)
-  std::vector<int64_t> env_streams_;  // the off-policy learner's stream id of each batch column
+  std::vector<int64_t> env_streams_;  // each batch column's stream id (Algorithm::learn)
 
   cluster::Communicator* ranks_;
   int rank_envs_;  // this rank's environments of a full batch
@@ -194,11 +191,10 @@ class Learner {
   double wall_offset_s_ = 0;  // wall time of the runs before a resume
   std::chrono::steady_clock::time_point start_, last_update_, last_publish_;
   std::chrono::steady_clock::time_point idle_since_;  // the end of the last update (or the start): what wait_s counts from
-  std::vector<int> restored_order_;  // shuffle permutation from a checkpoint, used once
   std::unique_ptr<LearningCurve> curve_;  // made with the first update: it needs the reward terms
-  // TensorBoard: the run's event file, fed with every metrics.csv and off_policy.csv row (rank 0).
+  // TensorBoard: the run's event file, fed with every row of metrics.csv and of the algorithm's round table (rank 0).
   std::unique_ptr<EventFile> events_;
-  std::unique_ptr<CsvEvents> metrics_events_, off_policy_events_;
+  std::unique_ptr<CsvEvents> metrics_events_, round_events_;
   int64_t max_updates_ = -1;              // of the current run(), for the ETA; -1: unknown
   double update_interval_s_ = 0;          // moving average of the wall time between updates
   UpdateReport report_;

@@ -33,7 +33,7 @@
 #include "learner/intake/drop_reason.hpp"
 #include "learner/learner.hpp"
 #include "learner/run_directory.hpp"
-#include "learner/sac/off_policy_rule.hpp"
+#include "learner/algorithms/algorithm_catalog.hpp"
 
 namespace {
 
@@ -105,7 +105,8 @@ void printClosingReport(masa::learner::Learner& learner, const std::string& who,
     std::cout << who << ": parameter broadcasts repeated for actors that had not acknowledged them "
               << learner.unacknowledgedRepeats() << "; actors that acknowledged parameters "
               << learner.acknowledgingActors() << std::endl;
-  std::cout << who << ": MLP chunk width: " << learner.model().chunkWidthSummary() << std::endl;
+  if (const std::string kernels = learner.algorithm().kernelSummary(); !kernels.empty())
+    std::cout << who << ": MLP chunk width: " << kernels << std::endl;
   std::cout << who << ": other messages rejected before decoding: " << learner.transport().rejectSummary();
   // Rank 0 of several hears the actors' heartbeats on the parameters' URL, another transport.
   if (&learner.publisher() != &learner.transport())
@@ -175,7 +176,7 @@ int main(int argc, char** argv) {
     opt.run_id = run_id;
     opt.ranks = ranks;
     opt.rank_check_every = rank_check_every;
-    opt.make_off_policy = masa::sac::makeOffPolicyRule;
+    opt.make_algorithm = masa::learner::makeAlgorithm;
     opt.verbose = lead;
     if (ranks) opt.rollout_url = masa::transport::rankRolloutUrl(url, ranks->rank(), ranks->size());
     if (!resume_dir.empty()) {

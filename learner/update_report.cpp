@@ -55,7 +55,7 @@ masa::lcmt_learner_stats statsMessage(const UpdateReport& report, const ReportCo
   s.mean_episode_length = static_cast<float>(report.mean_length);
   s.success_rate = static_cast<float>(report.success_rate);
   s.num_episodes = report.num_episodes;
-  const ppo::PpoStats& p = report.ppo;
+  const LearnFigures& p = report.learned;
   s.actor_loss = static_cast<float>(p.actor_loss);
   s.critic_loss = static_cast<float>(p.critic_loss);
   s.entropy = static_cast<float>(p.entropy);
@@ -94,7 +94,7 @@ void appendMetricsRow(const std::string& path, const UpdateReport& report, const
     for (const auto& n : columns.progress_names) f << ",eval_" << n;
     f << '\n';
   }
-  const ppo::PpoStats& p = report.ppo;
+  const LearnFigures& p = report.learned;
   f.precision(9);
   f << report.update << ',' << report.env_steps << ',' << report.wall_time_s << ','
     << report.fps << ',' << report.mean_return << ',' << report.mean_length << ',' << report.success_rate;
@@ -105,28 +105,6 @@ void appendMetricsRow(const std::string& path, const UpdateReport& report, const
   f << ',' << report.eval_return << ',' << report.eval_length << ',' << report.eval_success;
   for (double v : report.eval_progress) f << ',' << v;
   f << '\n';
-}
-
-std::string offPolicyProgressFigures(const std::vector<std::pair<std::string, double>>& figures) {
-  auto figure = [&](const char* name) {
-    for (const auto& [n, v] : figures)
-      if (n == name) return v;
-    return std::nan("");
-  };
-  char line[200];
-  if (figure("warming_up") == 2) {
-    std::snprintf(line, sizeof(line), "refilling the replay after a compact resume: %.0f transitions", figure("replay_size"));
-  } else if (figure("warming_up") > 0) {
-    std::snprintf(line, sizeof(line), "warming up: uniform random actions, replay %.0f", figure("replay_size"));
-  } else {
-    // TD3 has no temperature: alpha 0 and entropy NaN (off_policy_trainer.hpp).
-    const double alpha = figure("alpha"), entropy = figure("entropy");
-    char temperature[64] = "";
-    if (!std::isnan(entropy)) std::snprintf(temperature, sizeof(temperature), "  alpha %.4f  entropy %.2f", alpha, entropy);
-    std::snprintf(line, sizeof(line), "grad steps %.0f  q %.4f  actor %.4f%s  mean Q %.2f", figure("gradient_steps"),
-                  figure("q_loss"), figure("actor_loss"), temperature, figure("mean_q"));
-  }
-  return line;
 }
 
 void printProgress(const UpdateReport& report, const ReportColumns& columns, int64_t max_updates,
@@ -141,10 +119,6 @@ void printProgress(const UpdateReport& report, const ReportColumns& columns, int
   if (max_updates > 0) std::snprintf(total, sizeof(total), "/%lld", static_cast<long long>(max_updates));
   char success[32] = "";  // only for tasks with a success notion
   if (report.success_rate >= 0) std::snprintf(success, sizeof(success), "  success %.2f", report.success_rate);
-  char ppo[160] = "";
-  if (report.algorithm_figures.empty())
-    std::snprintf(ppo, sizeof(ppo), "kl %.5f  lr %.2e  actor %.4f  critic %.4f", report.ppo.kl, report.ppo.lr,
-                  report.ppo.actor_loss, report.ppo.critic_loss);
   char timing[64] = "";
   if (!std::isnan(report.learn_s) && !std::isnan(report.wait_s))
     std::snprintf(timing, sizeof(timing), "  learn %.3fs waited %.3fs", report.learn_s, report.wait_s);
@@ -159,7 +133,7 @@ void printProgress(const UpdateReport& report, const ReportColumns& columns, int
     std::snprintf(episodes, sizeof(episodes), "no episode ended yet");
   std::printf("update %lld%s  steps %lld  fps %.0f  %s%s  %s  dropped %lld chunks %lld envs%s%s\n",
               static_cast<long long>(done), total, static_cast<long long>(report.env_steps), report.fps, episodes, success,
-              report.algorithm_figures.empty() ? ppo : report.algorithm_figures.c_str(),
+              report.algorithm_figures.c_str(),
               static_cast<long long>(report.dropped_chunks), static_cast<long long>(report.dropped_envs), timing, eta);
   if (!std::isnan(report.eval_return)) {
     std::printf("  eval (policy mean, %d episodes): return %.3f  len %.1f", eval_episodes, report.eval_return,

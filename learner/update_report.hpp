@@ -15,8 +15,8 @@
 
 #include "common/cluster/communicator.hpp"
 #include "common/rollout/rollout.hpp"
+#include "learner/algorithm.hpp"
 #include "learner/intake/drop_reason.hpp"
-#include "learner/ppo/ppo_trainer.hpp"
 #include "masa/lcmt_learner_stats.hpp"
 
 namespace masa::learner {
@@ -32,7 +32,7 @@ struct UpdateReport {
   int64_t last_episodes_update = 0;
   double last_return = std::nan(""), last_length = std::nan("");
   std::vector<double> term_means;
-  ppo::PpoStats ppo;
+  LearnFigures learned;  // the algorithm's figures of the update (metrics.csv's algorithm columns)
   int64_t dropped_chunks = 0;  // by the assembler, every reason (lost included), since the run began
   int64_t dropped_envs = 0;    // by the collector (stale, overflow), since the run began
   // Where the update's interval went (rank 0's clock): learn_s computing it (PPO's epochs or the
@@ -43,14 +43,9 @@ struct UpdateReport {
   // The policy mean's evaluation (runner.eval_every): NaN in updates without one.
   double eval_return = std::nan(""), eval_length = std::nan(""), eval_success = std::nan("");
   std::vector<double> eval_progress;  // the task's progress figures (Task::progressNames)
-  // The progress line's figures of an algorithm other than PPO, in place of PPO's kl, lr and
-  // losses (empty for PPO): learner: off_policy's offPolicyProgressFigures().
+  // The algorithm's part of the progress line (Algorithm::progressFigures).
   std::string algorithm_figures;
 };
-
-// An off-policy round's part of the progress line: its gradient steps, twin-Q loss, temperature,
-// entropy and mean Q, or that it still acts at random (the run's off_policy.csv has every figure).
-std::string offPolicyProgressFigures(const std::vector<std::pair<std::string, double>>& figures);
 
 // Episode statistics of a batch: mean return, length and reward terms, and the success rate over
 // the episodes that have a success measure (-1 when none has). NaN means when no episode ended.

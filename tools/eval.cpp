@@ -23,6 +23,7 @@
 #include "common/render/strip_sampler.hpp"
 #include "common/sim/policy_evaluator.hpp"
 #include "learner/checkpoint.hpp"
+#include "learner/ppo_algorithm.hpp"
 #include "tasks/tasks.hpp"
 
 using namespace masa;
@@ -55,9 +56,13 @@ policy::LoadedPolicy loadTarget(const std::string& target, const std::vector<std
   policy::LoadedPolicy lp;
   lp.source = p.string();
   lp.config = config::loadRunConfig(config::defaultConfigsDir(), overrides, config.string());
+  // An off-policy run's checkpoint holds no policy (older ones held PPO's unused networks).
+  if (lp.config.learner != "ppo")
+    throw std::runtime_error(p.string() + ": the checkpoint of a run with learner: " + lp.config.learner + " holds no policy to " +
+                             "evaluate: evaluate the policy.bin beside it");
   lp.spec = sym::SymmetrySpec::load(lp.config.spec_path);
   lp.model = std::make_unique<model::ActorCritic<float>>(lp.spec, lp.config.model);
-  learner::readCheckpoint(p.string(), *lp.model, nullptr);
+  learner::loadPpoCheckpointModel(p.string(), *lp.model);
   return lp;
 }
 

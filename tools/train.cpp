@@ -28,7 +28,7 @@
 #include "common/transport/transport.hpp"
 #include "learner/learner.hpp"
 #include "learner/run_directory.hpp"
-#include "learner/sac/off_policy_rule.hpp"
+#include "learner/algorithms/algorithm_catalog.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
     lo.run_id = 1;
     lo.verbose = !quiet;
     lo.resume = !resume.empty();
-    lo.make_off_policy = masa::sac::makeOffPolicyRule;
+    lo.make_algorithm = masa::learner::makeAlgorithm;
     masa::learner::Learner learner(rc, lo);
     learner.setMaxUpdates(updates);
 
@@ -131,7 +131,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "masa_train: %lld updates, %lld env steps; run dir %s\n",
                  static_cast<long long>(learner.updates()), static_cast<long long>(learner.envSteps()),
                  learner.runDir().c_str());
-    std::fprintf(stderr, "masa_train: MLP chunk width: %s\n", learner.model().chunkWidthSummary().c_str());
+    if (const std::string kernels = learner.algorithm().kernelSummary(); !kernels.empty())
+      std::fprintf(stderr, "masa_train: MLP chunk width: %s\n", kernels.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_train: %s\n", e.what());
     return 2;

@@ -71,6 +71,7 @@ class PpoTrainer {
   // checkpoint must hold it for a resumed run to repeat the same minibatches. Sized by prepare() to
   // the whole batch (of every rank), the same on every rank.
   std::vector<int>& shuffleOrder() { return order_; }
+  const std::vector<int>& shuffleOrder() const { return order_; }
 
  private:
   void resizeForBatch(const RolloutBuffer& buffer);

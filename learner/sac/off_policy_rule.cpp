@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <istream>
 #include <ostream>
@@ -12,6 +13,7 @@
 #include "common/core/binary_io.hpp"
 #include "common/core/check.hpp"
 #include "common/model/method.hpp"
+#include "learner/learning_curve.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_policy_file.hpp"
 #include "learner/sac/trainer_factory.hpp"
@@ -50,11 +52,11 @@ OffPolicyRule::OffPolicyRule(const config::RunConfig& rc, Rng& rng)
 
 OffPolicyRule::~OffPolicyRule() = default;
 
-std::unique_ptr<learner::OffPolicyLearning> makeOffPolicyRule(const config::RunConfig& rc, Rng& rng) {
-  return std::make_unique<OffPolicyRule>(rc, rng);
+learner::LearnFigures OffPolicyRule::learn(ppo::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) {
+  return learn(batch.data(), env_streams, rng);
 }
 
-ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, std::span<const int64_t> env_streams, Rng& rng) {
+learner::LearnFigures OffPolicyRule::learn(const rollout::Rollout& b, std::span<const int64_t> env_streams, Rng& rng) {
   const int E = b.num_envs, T = b.horizon;
   MASA_CHECK(env_streams.empty() || static_cast<int>(env_streams.size()) == E,
              "off-policy learner: " << env_streams.size() << " stream ids for " << E << " environments");
@@ -85,7 +87,7 @@ ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, std::span<const in
   received_ += static_cast<long long>(E) * T;
   if (!fitted_ && received_ >= sc_.learning_starts) fitNormalizer();
 
-  ppo::PpoStats out;
+  learner::LearnFigures out;
   round_means_ = SacStats{};
   round_steps_ = 0;
   round_relabeled_share_ = 0;
@@ -126,10 +128,50 @@ ppo::PpoStats OffPolicyRule::learn(const rollout::Rollout& b, std::span<const in
   out.critic_loss = sums.q_loss;
   out.entropy = sums.entropy;
   out.sym_policy_loss = sums.symmetry_loss;
-  out.mean_value = sums.mean_q;
-  out.minibatches = n;
   return out;
 }
+
+std::string OffPolicyRule::progressFigures(const learner::LearnFigures&) const {
+  return offPolicyProgressFigures(roundFigures());
+}
+
+std::string OffPolicyRule::curveScript(const std::string& title, const std::vector<std::string>& term_names,
+                                       bool has_success) const {
+  return learner::learningCurveScript(title + " (off-policy)", term_names, has_success, false);
+}
+
+std::optional<learner::SideStateFile> OffPolicyRule::sideState() const {
+  return learner::SideStateFile{"off_policy_state.bin", {"masa off-policy learner state", "MASAOFF1"}};
+}
+
+void OffPolicyRule::loadCheckpointBody(std::istream& is, const std::string& source) {
+  if (is.peek() != std::char_traits<char>::eof())
+    throw std::runtime_error(source + ": an off-policy checkpoint holds nothing after the counters (corrupt checkpoint)");
+}
+
+std::string offPolicyProgressFigures(const std::vector<std::pair<std::string, double>>& figures) {
+  auto figure = [&](const char* name) {
+    for (const auto& [n, v] : figures)
+      if (n == name) return v;
+    return std::nan("");
+  };
+  char line[200];
+  if (figure("warming_up") == 2) {
+    std::snprintf(line, sizeof(line), "refilling the replay after a compact resume: %.0f transitions", figure("replay_size"));
+  } else if (figure("warming_up") > 0) {
+    std::snprintf(line, sizeof(line), "warming up: uniform random actions, replay %.0f", figure("replay_size"));
+  } else {
+    // TD3 has no temperature: alpha 0 and entropy NaN (off_policy_trainer.hpp).
+    const double alpha = figure("alpha"), entropy = figure("entropy");
+    char temperature[64] = "";
+    if (!std::isnan(entropy)) std::snprintf(temperature, sizeof(temperature), "  alpha %.4f  entropy %.2f", alpha, entropy);
+    std::snprintf(line, sizeof(line), "grad steps %.0f  q %.4f  actor %.4f%s  mean Q %.2f", figure("gradient_steps"),
+                  figure("q_loss"), figure("actor_loss"), temperature, figure("mean_q"));
+  }
+  return line;
+}
+
+
 
 std::vector<std::pair<std::string, double>> OffPolicyRule::roundFigures() const {
   const SacStats& m = round_means_;
@@ -197,8 +239,9 @@ void OffPolicyRule::fillPolicyMessage(masa::lcmt_policy_params& m) const {
   m.obs_std = norm_std_;
 }
 
-std::unique_ptr<model::ActorCritic<float>> OffPolicyRule::evaluationModel() const {
-  return toActorCritic(policy_, spec_, policyFileConfig(rc_, sc_, policy_.normalizes()).model);
+model::ActorCritic<float>& OffPolicyRule::evaluationModel() {
+  evaluation_model_ = toActorCritic(policy_, spec_, policyFileConfig(rc_, sc_, policy_.normalizes()).model);
+  return *evaluation_model_;
 }
 
 void OffPolicyRule::savePolicyFile(const std::string& path) const { saveSacPolicyFile(path, rc_, sc_, policy_, spec_); }

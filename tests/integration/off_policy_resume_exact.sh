@@ -38,8 +38,15 @@ for stop in stop_before stop_after; do
   [ ! -e $stop/off_policy_state.next.bin ] || fail "$stop: the next state is still there"
 done
 grep -q "a stop fell before the checkpoint" stop_before.log || fail "the stale next state went unreported: $(tail -n 2 stop_before.log)"
+# The checkpoint says whose it is: another algorithm does not resume it, and masa_eval does not
+# evaluate it (it holds no policy: before, it held PPO's untrained networks, which masa_eval ran).
+if "${train[@]}" --updates 14 --resume at5 --set learner=ppo --set ppo.minibatch_size=32 > other_algorithm.log 2>&1; then fail "a PPO learner resumed an off-policy checkpoint"; fi
+grep -q "is of a run with learner: off_policy; this run's learner is ppo" other_algorithm.log || fail "the refusal does not say why: $(tail -n 2 other_algorithm.log)"
+if "$build/tools/masa_eval" at5/checkpoint.bin --episodes 1 > eval_checkpoint.log 2>&1; then fail "masa_eval evaluated an off-policy checkpoint"; fi
+grep -q "evaluate the policy.bin beside it" eval_checkpoint.log || fail "masa_eval's refusal does not say what to do: $(tail -n 2 eval_checkpoint.log)"
+"$build/tools/masa_eval" at5/policy.bin --episodes 1 > eval_policy.log 2>&1 || fail "masa_eval refused the run's policy.bin"
 # The state is sealed: a flipped byte is refused by name, nothing is resumed from it.
 cp -r parts damaged && printf '\xff' | dd of=damaged/off_policy_state.bin bs=1 seek=200 conv=notrunc status=none
 if "${train[@]}" --updates 14 --resume damaged > damaged.log 2>&1; then fail "a damaged off_policy_state.bin was resumed"; fi
 grep -q "off_policy_state.bin" damaged.log || fail "the refusal does not name the file: $(tail -n 2 damaged.log)"
-echo "PASS: resumed at 5, bit for bit the run never stopped to 12 ($steps gradient steps); a stop between its two files at either point goes on the same; a damaged state refused by name"
+echo "PASS: resumed at 5, bit for bit the run never stopped to 12 ($steps gradient steps); a stop between its two files at either point goes on the same; another algorithm and masa_eval refuse its checkpoint; a damaged state refused by name"

@@ -139,12 +139,12 @@ TEST(LearnerNode, OneBatchFromAFakeActorMakesVersionOneAndPublishesParamsStatsAn
   EXPECT_EQ(params.version, 1);
   EXPECT_EQ(params.run_id, 77);
   EXPECT_EQ(params.task, "trifinger_lift");
-  const auto& p = learner.model().params().values();
-  const int policy = learner.model().policyParamCount();
+  const auto& p = learner.algorithm().evaluationModel().params().values();
+  const int policy = learner.algorithm().evaluationModel().policyParamCount();
   ASSERT_LT(policy, p.size()) << "the critic is not broadcast";
   ASSERT_EQ(params.num_params, policy);
   EXPECT_EQ(std::memcmp(params.params.data(), p.data(), policy * sizeof(float)), 0);
-  EXPECT_EQ(params.obs_dim, learner.model().obsDim());
+  EXPECT_EQ(params.obs_dim, learner.algorithm().evaluationModel().obsDim());
   for (float s : params.obs_std) EXPECT_GT(s, 0.0f);
 
   ASSERT_EQ(num_stats, 1);
@@ -276,7 +276,7 @@ TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv)
     second.send(a.transport(), 9, 1, 1);
     ASSERT_TRUE(stepUntilUpdate(a));
     ASSERT_EQ(a.version(), 2);
-    const auto& p = a.model().params().values();
+    const auto& p = a.algorithm().evaluationModel().params().values();
     params_a.assign(p.data(), p.data() + p.size());
   }
   LearnerOptions o = nodeOptions(dir_b, 0);  // run id from the checkpoint
@@ -288,7 +288,7 @@ TEST(LearnerNode, ResumedLearnerMakesTheBitwiseSameNextUpdateAndContinuesTheCsv)
   second.send(b.transport(), 9, 1, 1);
   ASSERT_TRUE(stepUntilUpdate(b));
   EXPECT_EQ(b.version(), 2);
-  const auto& p = b.model().params().values();
+  const auto& p = b.algorithm().evaluationModel().params().values();
   ASSERT_EQ(static_cast<std::size_t>(p.size()), params_a.size());
   EXPECT_EQ(std::memcmp(p.data(), params_a.data(), params_a.size() * sizeof(float)), 0);
 

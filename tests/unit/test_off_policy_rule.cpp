@@ -50,8 +50,8 @@ TEST(OffPolicyRule, ABatchJoinsReplayEnvironmentByEnvironmentCutAtItsEndTimeOuts
   b.truncated[b.step(1, 1)] = 1;   // env 1 is cut by the time limit at t = 1
   std::vector<float> final_obs(od, 777.0f);
   b.addFinal(1, 1, final_obs.data());
-  const ppo::PpoStats s = rule.learn(b, {}, rng);
-  EXPECT_EQ(s.minibatches, 0);  // warming up: 6 of 1000 transitions
+  rule.learn(b, {}, rng);
+  EXPECT_EQ(rule.roundGradientSteps(), 0);  // warming up: 6 of 1000 transitions
   ASSERT_EQ(rule.replay().size(), 6);
   EXPECT_EQ(rule.gradientSteps(), 0);
 
@@ -83,13 +83,16 @@ TEST(OffPolicyRule, WarmsUpThenTakesTheStepsOwedAndSendsTheNormalizerItUses) {
   const int od = rule.replay().obsDim(), ad = rule.replay().actDim();
   const auto b = batchOf(2, 3, od, ad);
   masa::lcmt_policy_params m;
-  EXPECT_EQ(rule.learn(b, {}, rng).minibatches, 0);  // 6 < 8
+  rule.learn(b, {}, rng);
+  EXPECT_EQ(rule.roundGradientSteps(), 0);  // 6 < 8
   rule.fillPolicyMessage(m);
   EXPECT_EQ(m.obs_dim, 0) << "while warming up the parameters go without a normalizer";
   EXPECT_EQ(m.num_params, static_cast<int>(rule.policy().params().size()));
   // 12 transitions: floor(0.5 x (12 - 8 + 1)) = 2 steps; 18: floor(0.5 x 11) = 5, 3 more.
-  EXPECT_EQ(rule.learn(b, {}, rng).minibatches, 2);
-  EXPECT_EQ(rule.learn(b, {}, rng).minibatches, 3);
+  rule.learn(b, {}, rng);
+  EXPECT_EQ(rule.roundGradientSteps(), 2);
+  rule.learn(b, {}, rng);
+  EXPECT_EQ(rule.roundGradientSteps(), 3);
   EXPECT_EQ(rule.gradientSteps(), 5);
   rule.fillPolicyMessage(m);
   ASSERT_EQ(m.obs_dim, od);
@@ -131,11 +134,13 @@ TEST(OffPolicyRule, ACompactStateKeepsTheNewestTransitionsAndTheResumedRunRefill
   }
   EXPECT_EQ(back.gradientSteps(), 6);
   // 2 + 6 = 8 stored, below 12: refilling, no steps (3 were owed for these transitions).
-  EXPECT_EQ(back.learn(b, {}, other).minibatches, 0);
+  back.learn(b, {}, other);
+  EXPECT_EQ(back.roundGradientSteps(), 0);
   EXPECT_EQ(back.roundFigures()[3].second, 2.0) << back.roundFigures()[3].first;  // warming_up: refilling
-  EXPECT_EQ(learner::offPolicyProgressFigures(back.roundFigures()), "refilling the replay after a compact resume: 8 transitions");
+  EXPECT_EQ(sac::offPolicyProgressFigures(back.roundFigures()), "refilling the replay after a compact resume: 8 transitions");
   // 14 stored: the round's own 3 steps, none for the wait.
-  EXPECT_EQ(back.learn(b, {}, other).minibatches, 3);
+  back.learn(b, {}, other);
+  EXPECT_EQ(back.roundGradientSteps(), 3);
   EXPECT_EQ(back.gradientSteps(), 9);
   // The forgiven steps travel in the (compact) state too.
   std::stringstream again;
@@ -206,9 +211,9 @@ TEST(OffPolicyRule, TheProgressLineShowsTheRoundsGradientStepsTemperatureAndEntr
     OffPolicyRule rule(rc, rng);
     const auto b = batchOf(2, 3, rule.replay().obsDim(), rule.replay().actDim());
     rule.learn(b, {}, rng);
-    EXPECT_EQ(learner::offPolicyProgressFigures(rule.roundFigures()), "warming up: uniform random actions, replay 6");
+    EXPECT_EQ(sac::offPolicyProgressFigures(rule.roundFigures()), "warming up: uniform random actions, replay 6");
     rule.learn(b, {}, rng);  // floor(1 x (12 - 8 + 1)) = 5 steps
-    const std::string line = learner::offPolicyProgressFigures(rule.roundFigures());
+    const std::string line = sac::offPolicyProgressFigures(rule.roundFigures());
     EXPECT_EQ(line.rfind("grad steps 5  q ", 0), 0u) << line;
     EXPECT_EQ(line.find("nan"), std::string::npos) << line;
     EXPECT_NE(line.find("mean Q "), std::string::npos) << line;
