@@ -79,25 +79,12 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::M
   const auto& terms = envs_[0]->rewardTermNames();
   num_terms_ = static_cast<int>(terms.size());
 
-  // The whole model once, for its parameter count (a learner may broadcast it whole) and the
-  // initial parameters' draws; the actor keeps only its policy half.
-  int model_param_count = 0;
-  {
-    model::ActorCritic<float> model(spec, config_.model);
-    model_param_count = model.params().size();
-    // Own initial parameters: used only with start_without_learner, and deterministic per seed.
-    Rng init_rng = envRng(config_.seed, options_.actor_id, -1);
-    model.initialize(init_rng);
-    policy_ = model::InferencePolicy<float>::of(model);
-    policy_param_count_ = policy_->params().size();
-    if (config_.learner == "off_policy") {
-      squashed_ = std::make_unique<SquashedBehaviour>(config_, spec);
-      squashed_->initialize(init_rng);
-    }
-  }
-  if (squashed_) {
-    policy_param_count_ = model_param_count = squashed_->paramCount();  // the learner sends the policy only
-  }
+  behaviour_ = makeBehaviour(config_, spec);
+  // Own initial parameters: used only with start_without_learner, and deterministic per seed.
+  Rng init_rng = envRng(config_.seed, options_.actor_id, -1);
+  behaviour_->initialize(init_rng);
+  policy_param_count_ = behaviour_->policyParamCount();
+  const int model_param_count = behaviour_->modelParamCount();
   params_check_ = std::make_unique<ParamsCheck>(ParamsExpectation{
       .run_id = options_.run_id, .task = config_.task, .method = model::methodName(config_.method),
       .policy_param_count = policy_param_count_, .model_param_count = model_param_count,
@@ -195,15 +182,8 @@ void Actor::rejectParams(int64_t version, const std::string& why) {
 
 void Actor::swapInPending() {
   if (pending_version_ < 0) return;
-  if (squashed_) {
-    squashed_->set(pending_params_.data(), pending_has_norm_ ? pending_mean_.data() : nullptr,
-                   pending_has_norm_ ? pending_std_.data() : nullptr);
-  } else {
-    // The policy prefix (a whole model's critic part is not the actor's).
-    auto& values = policy_->params().values();
-    std::copy(pending_params_.begin(), pending_params_.begin() + std::min<int>(pending_count_, values.size()), values.data());
-    if (pending_has_norm_) policy_->obsNormalizer().setMeanStd(pending_mean_.data(), pending_std_.data());
-  }
+  behaviour_->set(pending_params_.data(), pending_count_, pending_has_norm_ ? pending_mean_.data() : nullptr,
+                  pending_has_norm_ ? pending_std_.data() : nullptr);
   version_ = pending_version_;
   pending_version_ = -1;
 }
@@ -277,8 +257,7 @@ bool Actor::collectAndPublish() {
   const int64_t acting_version = version_;
   const int E = num_envs_;
   rollout_.clearEvents();
-  if (squashed_) log_std_.setZero();  // SAC's std depends on the state; the field is PPO's
-  else policy_->logStd(log_std_);
+  behaviour_->logStd(log_std_);
   rollout_.setLogStd(log_std_.data());
 
   for (int e = 0; e < E; ++e) envs_[e]->observe(rollout_.obsAt(0, e));
@@ -287,14 +266,9 @@ bool Actor::collectAndPublish() {
     // Step t's observations, actions and means are contiguous obs_dim x E / act_dim x E blocks.
     Eigen::Map<const Mat<float>> obs(rollout_.obsAt(t, 0), obs_dim_, E);
     float* log_prob = rollout_.log_prob.data() + rollout_.step(t, 0);
-    singleThreaded([&] {
-      if (squashed_) {  // the whole block's actions at once, each environment's noise its own
-        squashed_->act(obs, rngs_, Eigen::Map<Mat<float>>(rollout_.actionAt(t, 0), act_dim_, E),
-                       Eigen::Map<Mat<float>>(rollout_.meanAt(t, 0), act_dim_, E), log_prob);
-        return;
-      }
-      auto mean = policy_->actMean(obs);
-      Eigen::Map<Mat<float>>(rollout_.meanAt(t, 0), act_dim_, E) = mean;
+    singleThreaded([&] {  // the whole block's actions at once, each environment's noise its own
+      behaviour_->act(obs, rngs_, Eigen::Map<Mat<float>>(rollout_.actionAt(t, 0), act_dim_, E),
+                      Eigen::Map<Mat<float>>(rollout_.meanAt(t, 0), act_dim_, E), log_prob);
     });
     float* reward = rollout_.reward.data() + rollout_.step(t, 0);
     uint8_t* term = rollout_.terminated.data() + rollout_.step(t, 0);
@@ -302,13 +276,6 @@ bool Actor::collectAndPublish() {
 
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int e = 0; e < E; ++e) {
-      if (!squashed_) {
-        Eigen::Map<const Mat<float>> mu(rollout_.meanAt(t, e), act_dim_, 1);
-        Eigen::Map<Mat<float>> act(rollout_.actionAt(t, e), act_dim_, 1);
-        Eigen::Map<Mat<float>> lp(log_prob + e, 1, 1);
-        model::gaussian::sample<float>(mu, log_std_, rngs_[e], act);
-        model::gaussian::logProb<float>(mu, log_std_, act, lp);
-      }
       auto& env = *envs_[e];
       const task::StepOutcome out = env.step(rollout_.actionAt(t, e));
       reward[e] = static_cast<float>(out.reward);

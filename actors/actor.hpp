@@ -1,7 +1,7 @@
 // An actor process's worker: E task instances stepped together, acting with the newest policy
-// received from the learner, and streaming each T-step rollout as LCM chunks. The policy is PPO's
-// Gaussian, or with learner: off_policy the SAC policy (squashed_behaviour.hpp); the rollouts are
-// the same either way.
+// received from the learner, and streaming each T-step rollout as LCM chunks. How it acts is its
+// behaviour (behaviour.hpp): PPO's Gaussian, or with learner: off_policy the SAC or TD3 policy;
+// the rollouts are the same either way.
 //
 // Determinism: environment e of actor a draws resets and action noise from its own Rng, seeded
 // from (run seed, a, e), so a run is reproducible for any thread count. Parameters received while
@@ -22,14 +22,13 @@
 #include <vector>
 
 #include "common/config/run_config.hpp"
-#include "common/model/inference_policy.hpp"
 #include "common/sim/registry.hpp"
 #include "actors/await_budget.hpp"
+#include "actors/behaviour.hpp"
 #include "actors/params_check.hpp"
 #include "actors/policy_lag_window.hpp"
 #include "common/rollout/rollout.hpp"
 #include "actors/rollout_chunker.hpp"
-#include "actors/squashed_behaviour.hpp"
 #include "common/transport/message_bus.hpp"
 #include "common/transport/transport.hpp"
 #include "masa/lcmt_policy_params.hpp"
@@ -133,8 +132,8 @@ class Actor {
   const transport::MessageBus& transport() const { return *transport_; }
   const rollout::Rollout& lastRollout() const { return rollout_; }
   int numEnvs() const { return num_envs_; }
-  // What the actor acts with (learner: ppo): the policy half of the learner's model.
-  model::InferencePolicy<float>& policy() { return *policy_; }
+  // What the actor acts with (gaussian_behaviour.hpp or squashed_behaviour.hpp).
+  Behaviour& behaviour() { return *behaviour_; }
   void publishHeartbeat();
 
   // The environments between two rollouts (actors/actor_environments.cpp): each task's state and
@@ -168,9 +167,7 @@ class Actor {
   std::unique_ptr<task::TaskFactory> factory_;
   std::vector<std::unique_ptr<task::Task>> envs_;
   std::vector<Rng> rngs_;
-  std::unique_ptr<model::InferencePolicy<float>> policy_;  // no critic: the actor never trains
-  // learner: off_policy: the actions come from the SAC policy instead (policy_ only sizes nothing).
-  std::unique_ptr<SquashedBehaviour> squashed_;
+  std::unique_ptr<Behaviour> behaviour_;
   int policy_param_count_ = 0;  // the policy + log-std prefix of the flat parameters
   std::unique_ptr<ParamsCheck> params_check_;  // made once the model's sizes are known
   rollout::Rollout rollout_;

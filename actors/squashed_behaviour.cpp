@@ -17,9 +17,9 @@ void SquashedBehaviour::initialize(Rng& rng) {
   warming_up_ = true;
 }
 
-void SquashedBehaviour::set(const float* params, const float* mean, const float* std) {
+void SquashedBehaviour::set(const float* params, int count, const float* mean, const float* std) {
   auto& values = policy_.params().values();
-  std::copy(params, params + values.size(), values.data());
+  std::copy(params, params + std::min<int>(count, static_cast<int>(values.size())), values.data());
   warming_up_ = mean == nullptr;
   if (!warming_up_) {
     policy_.obsNormalizer().setMeanStd(mean, std);

@@ -12,28 +12,30 @@
 #include <memory>
 #include <vector>
 
+#include "actors/behaviour.hpp"
 #include "common/config/run_config.hpp"
 #include "common/config/sac_config.hpp"
 #include "common/model/sac_policy.hpp"
 
 namespace masa::actor {
 
-class SquashedBehaviour {
+class SquashedBehaviour final : public Behaviour {
  public:
   SquashedBehaviour(const config::RunConfig& rc, const sym::SymmetrySpec& spec);
 
-  int paramCount() const { return static_cast<int>(policy_.params().size()); }
+  int policyParamCount() const override { return static_cast<int>(policy_.params().size()); }
   // Own initial parameters (start_without_learner): warming up, so uniform actions.
-  void initialize(Rng& rng);
+  void initialize(Rng& rng) override;
   // Parameters of a checked message; `mean`/`std` null: no normalizer yet, the learner warms up.
-  void set(const float* params, const float* mean, const float* std);
+  void set(const float* params, int count, const float* mean, const float* std) override;
   bool warmingUp() const { return warming_up_; }
+  // SAC's std depends on the state: the rollout's log-std field (PPO's) is 0.
+  void logStd(Eigen::VectorXf& out) const override { out.setZero(); }
 
-  // Actions for the observations of E environments (obs_dim x E, raw), environment e's noise from
-  // rngs[e]. Writes actions and the pre-squash mean (act_dim x E) and log pi of each action (SAC;
-  // TD3's deterministic policy has none: 0). During the warm-up: uniform in [-1, 1], mean 0.
+  // The pre-squash mean, and log pi of each action (SAC; TD3's deterministic policy has none: 0).
+  // During the warm-up: uniform in [-1, 1], mean 0.
   void act(const ConstMatRef<float>& obs, std::vector<Rng>& rngs, MatRef<float> actions, MatRef<float> mean,
-           float* log_prob);
+           float* log_prob) override;
 
  private:
   sac::SacConfig sc_;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "actors/actor.hpp"
+#include "actors/gaussian_behaviour.hpp"
 #include "common/config/run_config.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
@@ -30,6 +31,11 @@ namespace masa {
 namespace {
 
 constexpr int64_t kRolloutRunId = 777;
+
+// A PPO run's actor acts with the policy half of the learner's model.
+model::InferencePolicy<float>& gaussianPolicy(actor::Actor& a) {
+  return dynamic_cast<actor::GaussianBehaviour&>(a.behaviour()).policy();
+}
 constexpr int kHorizon = 8;
 constexpr int kEpisodeSteps = 5;  // shorter than the horizon: every env finishes an episode
 
@@ -205,8 +211,8 @@ TEST(ActorRollouts, ParametersPublishedMidRolloutApplyFromTheNextRollout) {
   }
   // The swapped-in parameters and normalizer are the broadcast ones.
   const auto msg = learner.message(2, 0.05f);
-  for (int i = 0; i < msg.num_params; ++i) ASSERT_EQ(actor.policy().params().values()[i], msg.params[i]);
-  EXPECT_NEAR(actor.policy().obsNormalizer().mean()[0], 0.1, 1e-6);
+  for (int i = 0; i < msg.num_params; ++i) ASSERT_EQ(gaussianPolicy(actor).params().values()[i], msg.params[i]);
+  EXPECT_NEAR(gaussianPolicy(actor).obsNormalizer().mean()[0], 0.1, 1e-6);
 }
 
 std::vector<std::vector<uint8_t>> runOnce(uint64_t seed, int threads) {
@@ -399,7 +405,7 @@ TEST(ActorRollouts, AVersionTheLearnerNeverPublishedIsGivenUpWhenTheLearnerKeeps
   actor.pollParams(10);
   ASSERT_TRUE(actor.collectAndPublish());
   EXPECT_EQ(actor.policyVersion(), 7);
-  EXPECT_EQ(actor.policy().params().values().head(3), learner.model.params().values().head(3));
+  EXPECT_EQ(gaussianPolicy(actor).params().values().head(3), learner.model.params().values().head(3));
   // A repeat at the actor's version in between resets the count.
   bus.publish(transport::kPolicyChannel, learner.message(985, 0.25f));
   actor.pollParams(10);
@@ -423,7 +429,7 @@ TEST(ActorRollouts, WholeModelParametersAreAcceptedAsWellAsThePolicyPrefix) {
   bus.publish(transport::kPolicyChannel, whole);
   ASSERT_TRUE(actor.pollParams(10));
   // The critic part is not the actor's: it keeps the policy prefix.
-  EXPECT_EQ(actor.policy().params().values(), learner.model.params().values().head(learner.model.policyParamCount()));
+  EXPECT_EQ(gaussianPolicy(actor).params().values(), learner.model.params().values().head(learner.model.policyParamCount()));
 }
 
 TEST(ActorRollouts, StartWithoutLearnerActsWithVersionZero) {

@@ -99,7 +99,7 @@ TEST(OffPolicyRule, WarmsUpThenTakesTheStepsOwedAndSendsTheNormalizerItUses) {
 
   // An actor acting with the message: its pre-squash mean is the learner's, exactly.
   actor::SquashedBehaviour actor(rc, sym::SymmetrySpec::load(rc.spec_path));
-  actor.set(m.params.data(), m.obs_mean.data(), m.obs_std.data());
+  actor.set(m.params.data(), m.num_params, m.obs_mean.data(), m.obs_std.data());
   ASSERT_FALSE(actor.warmingUp());
   Mat<float> obs = Mat<float>::Random(od, 3), act(ad, 3), mean(ad, 3), on;
   std::vector<Rng> rngs{Rng(1), Rng(2), Rng(3)};
