@@ -53,6 +53,16 @@ Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::Symm
   qvel_scratch_.assign(model_->get()->nv, 0.0);
   ctrl_scratch_.assign(model_->get()->nu, 0.0);
   episode_.term_sums.assign(term_names_.size(), 0.0);
+  const RandomizationConfig randomization = RandomizationConfig::read(params);
+  if (randomization.enabled) {
+    // Its own copy of the model, written every episode; the derived data is remade for it.
+    auto own = model_->clone();
+    mjModel* m = own->mutableModel();
+    model_ = std::move(own);
+    mj_deleteData(data_);
+    data_ = mj_makeData(model_->get());
+    randomization_ = std::make_unique<PhysicsRandomization>(randomization, m, spec_, action_joint_, action_actuator_);
+  }
 }
 
 Task::~Task() { mj_deleteData(data_); }
@@ -103,6 +113,11 @@ void Task::bindActuators() {
 double Task::controlTimestep() const { return frame_skip_ * model_->get()->opt.timestep; }
 
 void Task::reset(Rng& rng) {
+  if (randomization_) {
+    randomization_->drawEpisode(rng);
+    noise_seed_ = static_cast<double>(rng() >> 11);  // exact in a double: saved with the state
+    commanded_.assign(static_cast<std::size_t>(randomization_->latencySteps()) + 2, std::vector<double>(actDim(), 0.0));
+  }
   mj_resetData(model_->get(), data_);
   std::fill(last_action_.begin(), last_action_.end(), 0.0);
   resetTask(rng);
@@ -115,7 +130,15 @@ void Task::reset(Rng& rng) {
   episode_.terminated = episode_.truncated = false;
 }
 
-void Task::observe(float* out) const { writeObservation(out); }
+void Task::observe(float* out) const {
+  writeObservation(out);
+  if (randomization_) {
+    // The step's noise, a function of the episode's seed and the step: the same state observes
+    // the same, also in a copy or a resumed actor.
+    Rng noise(static_cast<uint64_t>(noise_seed_) ^ (0x9E3779B97F4A7C15ULL * static_cast<uint64_t>(episode_.length + 1)));
+    randomization_->perturbObservation(out, obsDim(), noise);
+  }
+}
 
 void Task::setMeasuredState(const double* joint_pos, const double* joint_vel, const double* base_pose7,
                             const double* base_vel6, const double* last_action) {
@@ -171,6 +194,22 @@ StepOutcome Task::step(std::span<const float> action) {
 void Task::advancePhysics(const float* action) {
   const mjModel* m = model_->get();
   setControls(action);
+  if (randomization_ && (randomization_->latencySteps() > 0 || randomization_->latencyFraction() > 0.0)) {
+    // The latency: the action of latencySteps() steps ago drives this step, and the one before
+    // it the first substeps of the fraction.
+    commanded_.erase(commanded_.begin());
+    commanded_.push_back(action_scratch_);
+    // commanded_ holds latencySteps() + 2 actions, newest last (zeros before the episode's first).
+    const int late = static_cast<int>(std::lround(randomization_->latencyFraction() * frame_skip_));
+    const std::vector<double>& delayed = commanded_[1];
+    const std::vector<double>& older = commanded_[0];
+    for (int s = 0; s < frame_skip_; ++s) {
+      applyAction(s < late ? older.data() : delayed.data());
+      beforeSubstep();
+      mj_step(m, data_);
+    }
+    return;
+  }
   for (int s = 0; s < frame_skip_; ++s) {
     beforeSubstep();
     mj_step(m, data_);
@@ -370,6 +409,11 @@ void Task::applySymmetry(int i) {
   Eigen::VectorXd ta(actDim());
   t.apply<double>(a, ta);
   std::copy(ta.data(), ta.data() + actDim(), last_action_.begin());
+  for (auto& c : commanded_) {  // the delayed actions are actions too
+    Eigen::Map<Eigen::VectorXd> ca(c.data(), actDim());
+    t.apply<double>(Eigen::VectorXd(ca), ta);
+    ca = ta;
+  }
   transformExtras(i);
   forwardKeepingState();
 }

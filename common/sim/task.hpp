@@ -23,6 +23,7 @@
 #include "common/sim/env_params.hpp"
 #include "common/sim/goal_relabeling.hpp"
 #include "common/sim/mujoco_model.hpp"
+#include "common/sim/physics_randomization.hpp"
 
 namespace masa::task {
 
@@ -68,8 +69,10 @@ class Task {
   const std::vector<std::string>& rewardTermNames() const { return term_names_; }
   const std::vector<double>& rewardTerms() const { return terms_; }  // last step, weighted
 
+  // A new episode from rng: with env.randomization, its physics drawn first
+  // (common/sim/physics_randomization.hpp), then the task's own reset.
   void reset(Rng& rng);
-  void observe(float* out) const;             // obsDim() values
+  void observe(float* out) const;             // obsDim() values (with env.randomization's noise)
   StepOutcome step(const float* action);      // actDim() values, clamped to [-1, 1]
   StepOutcome step(std::span<const float> action);  // the same, checking the size
   // The physics of step() alone: clamping, actuation, frame-skip substeps (with their control
@@ -128,6 +131,8 @@ class Task {
   int jointOfAction(int k) const { return action_joint_[k]; }
 
   const mjModel* model() const { return model_->get(); }
+  // The episode's randomized physics (null without env.randomization).
+  const PhysicsRandomization* randomization() const { return randomization_.get(); }
   const MujocoModel& mujocoModel() const { return *model_; }  // with its file path and named lookups
   const mjData* data() const { return data_; }
   mjData* data() { return data_; }
@@ -220,6 +225,11 @@ class Task {
   std::vector<double> last_action_, action_scratch_;
   std::vector<double> qpos_scratch_, qvel_scratch_, ctrl_scratch_;
   EpisodeStats episode_;
+  // env.randomization: the task's own copy of the model, drawn anew each episode; the commanded
+  // actions of the latency's last steps (newest last, clamped); the episode's noise seed.
+  std::unique_ptr<PhysicsRandomization> randomization_;
+  std::vector<std::vector<double>> commanded_;
+  double noise_seed_ = 0.0;
 };
 
 }  // namespace masa::task

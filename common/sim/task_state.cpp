@@ -70,6 +70,15 @@ void Task::saveState(std::vector<double>& out) const {
                          double(episode_.terminated), double(episode_.truncated)});
   put(episode_.term_sums.data(), episode_.term_sums.size());
   put(terms_.data(), terms_.size());
+  if (randomization_) {  // the episode's physics, noise seed and delayed actions (only then: old states keep their layout)
+    const std::size_t at = out.size();
+    out.push_back(0.0);
+    randomization_->save(out);
+    out.push_back(noise_seed_);
+    out.push_back(static_cast<double>(commanded_.size()));
+    for (const auto& c : commanded_) put(c.data(), c.size());
+    out[at] = static_cast<double>(out.size() - at - 1);
+  }
   const std::size_t count_at = out.size();
   out.push_back(0.0);
   saveExtras(out);
@@ -110,6 +119,24 @@ void Task::loadState(std::span<const double> in) {
   episode_.truncated = r.one("the episode's flags") != 0.0;
   r.into(episode_.term_sums.data(), episode_.term_sums.size(), "the episode's reward terms");
   r.into(terms_.data(), terms_.size(), "the last step's reward terms");
+  if (randomization_) {
+    const double n = r.one("the count of the randomized physics");
+    if (!(n >= 0.0 && n <= static_cast<double>(r.left())))
+      throw std::runtime_error("task state of " + name_ + ": the randomized physics says " + std::to_string(n) + " values");
+    const std::span<const double> block = r.take(static_cast<std::size_t>(n), "the randomized physics");
+    std::size_t at = randomization_->load(block, name_);
+    if (block.size() < at + 2) throw std::runtime_error("task state of " + name_ + ": the randomized physics is cut short");
+    noise_seed_ = block[at++];
+    const double steps = block[at++];
+    if (!(steps >= 2.0 && steps == static_cast<double>(randomization_->latencySteps() + 2) &&
+          block.size() == at + static_cast<std::size_t>(steps) * actDim()))
+      throw std::runtime_error("task state of " + name_ + ": the delayed actions do not match the latency");
+    commanded_.assign(static_cast<std::size_t>(steps), std::vector<double>(actDim(), 0.0));
+    for (auto& c : commanded_) {
+      std::copy(block.begin() + static_cast<std::ptrdiff_t>(at), block.begin() + static_cast<std::ptrdiff_t>(at + actDim()), c.begin());
+      at += actDim();
+    }
+  }
   const double count = r.one("the count of the task's extras");
   if (!(count >= 0.0 && count == static_cast<double>(r.left())))
     throw std::runtime_error("task state of " + name_ + ": " + std::to_string(r.left()) +
