@@ -36,6 +36,7 @@
 #include "common/transport/channels.hpp"
 #include "common/transport/signed_publisher.hpp"
 #include "common/transport/transport.hpp"
+#include "deploy/sim_robot/command_lead.hpp"
 #include "deploy/sim_robot/command_link.hpp"
 #include "deploy/sim_robot/command_timeout.hpp"
 #include "deploy/sim_robot/run_record.hpp"
@@ -64,7 +65,7 @@ int main(int argc, char** argv) {
   double tilt_state_after = -1, tilt_rad = 1.0;
   int state_every = 1;
   bool quiet = false;
-  double command_timeout_ms = 150, damping_kd = 2.0;
+  double command_timeout_ms = 150, damping_kd = 2.0, command_lead_ms = 100;
   app.add_option("policy", policy_path, "policy file: its task is built exactly as trained")->required()->check(CLI::ExistingFile);
   app.add_option("--seed", seed, "the task resets from this seed (masa_eval's episode 0 of --seed)")->capture_default_str();
   app.add_option("--duration", duration, "seconds of simulated time after the first command")->capture_default_str()
@@ -86,6 +87,9 @@ int main(int argc, char** argv) {
                  "no command for this long: the robot damps itself (0: hold the last command for good)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--damping-kd", damping_kd, "kd of the robot's own damping (N m s / rad; the runner's safe.damping_kd)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--command-lead-ms", command_lead_ms,
+                 "refuse a command whose utime is ahead of this robot's clock by more than this")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   std::string roster_file;
   app.add_option("--roster", roster_file,
@@ -129,6 +133,7 @@ int main(int argc, char** argv) {
     deploy::CommandLink link(loss, delay_ms, jitter_ms, fault_seed);
     deploy::RunRecord record(*task);
     deploy::CommandTimeout command_timeout(command_timeout_ms * 1e-3, damping_kd, n);
+    deploy::CommandLead command_lead(static_cast<int64_t>(command_lead_ms * 1e3));
     if (command_timeout_ms > 0)
       std::fprintf(stderr, "masa_sim_robot: no command for %.0f ms: the robot damps itself (kp 0, kd %g)\n",
                    command_timeout_ms, damping_kd);
@@ -140,6 +145,7 @@ int main(int argc, char** argv) {
       // trailer is not part of the command.
       if (!verifying) size = transport::sizeWithoutSigTrailer(data, size);
       if (transport::decodeChecked(data, size, incoming) != transport::WireVerdict::kOk || incoming.num_joints != n) return;
+      if (!command_lead.admits(incoming.utime, transport::wallClockMicros())) return;  // counted; changes nothing
       record.commandArrived(incoming);
       const double now = wall();
       if (link.receive(incoming, now)) command_timeout.arrived(incoming, now);
@@ -193,6 +199,8 @@ int main(int argc, char** argv) {
     robot.updateKinematics();
     const std::vector<double> angles = robot.jointAngles();
     const std::string refused = verifying ? verifying->rejectSummary() : "";
+    std::printf("masa_sim_robot: commands refused after decoding: ahead_of_clock %lld (utime more than %.0f ms ahead of "
+                "the robot's clock)\n", static_cast<long long>(command_lead.refused()), command_lead_ms);
     record.print(steps * dt, link.lostCommands(), link.lostStates(), verifying ? refused.c_str() : nullptr,
                  tilt_state_after >= 0 ? &angles : nullptr, command_timeout);
     return 0;

@@ -35,6 +35,10 @@
 #                 --signing-key) and the runner verifies it (--verify-state): it walks the robot while
 #                 a forger's replayed, actor-signed and unsigned states (NaN angles, a utime from the
 #                 future) are refused and counted; the same forger trips a runner that does not verify
+#   future_command  beside the runner, a forger sends each of its commands again changed (an
+#                 emergency stop) and stamped 10 s ahead, unsigned, to a robot that takes unsigned
+#                 commands: the robot refuses them by its clock (ahead_of_clock), spends no physics
+#                 step in mode 4 and walks under the runner
 # A real-time runner on a loaded machine can miss its state for 50 ms and trip its watchdog, which is
 # the watchdog doing its job, not what these cases test: walk, walk_tuned, faults and crouch (and
 # stale and nan, for a trip before their fault) say such a run and try it once more; a second trip
@@ -325,6 +329,32 @@ signed_state)
   echo "runner that does not verify: $(grep -m1 -oE '(damping|hold|emergency stop): .*' "$work/deploy2.log")"
   echo "PASS: the verifying runner took the robot's signed state only; replayed, actor-signed and unsigned state were refused"
   ;;
+future_command)
+  forger="$build/tests/masa_test_robot_message_forger"
+  [ -x "$forger" ] || fail "$forger is missing: build first"
+  for attempt in 1 2; do
+    "$sim" "$policy" --seed 0 --duration 4.5 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$forger" --future --duration 8 > "$work/forger.log" 2>&1 & forger_pid=$!; pids+=($forger_pid)
+    timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps 100 --exit-on-trip --quiet \
+      > "$work/deploy.log" 2>&1
+    rc=$?
+    wait "$sim_pid"; kill -INT "$forger_pid" 2>/dev/null; wait "$forger_pid"
+    [ "$rc" -eq 0 ] && break
+    grep -qE "estop [1-9][0-9]* physics steps" "$work/sim.log" &&
+      fail "the robot applied a forged far-future command: $(grep 'command modes' "$work/sim.log")"
+    retry_after_stale_trip "$attempt" "beside the command forger" || fail "masa_deploy exited with $rc"
+  done
+  grep -qE "robot command forger: [1-9][0-9]* unsigned commands 10 s in the future" "$work/forger.log" ||
+    fail "the forger sent nothing: $(cat "$work/forger.log")"
+  modes=$(grep "command modes" "$work/sim.log") || fail "no command modes from the simulated robot"
+  grep -q "estop 0 physics steps" <<< "$modes" || fail "the robot applied a forged far-future command: $modes"
+  refused=$(grep "commands refused after decoding" "$work/sim.log") || fail "the robot did not count commands refused by its clock"
+  [[ $refused =~ ahead_of_clock\ [1-9] ]] || fail "no command refused as ahead_of_clock: $refused"
+  grep -q "policy phase" "$work/sim.log" || fail "the robot took none of the runner's policy commands"
+  grep -q "fell: no" "$work/sim.log" || fail "the robot fell"
+  echo "$refused; $(grep -o 'forger: .*' "$work/forger.log")"
+  echo "PASS: forged commands stamped 10 s ahead were refused by the robot's clock and did not move it"
+  ;;
 foreign_runner)
   # One unsigned command with another runner_id, as anyone on the robot's LAN can send, 2 s into the
   # policy: the runner stops (exit 3), and the last command it put on the wire is the safe one.
@@ -442,5 +472,5 @@ command_timeout)
   done
   echo "PASS: the robot damped itself within its command timeout once the runner was killed"
   ;;
-*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands|signed_state|foreign_runner|foreign_runner_signed|safe_stop|command_timeout PORT"; exit 2 ;;
+*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands|signed_state|foreign_runner|foreign_runner_signed|safe_stop|command_timeout|future_command PORT"; exit 2 ;;
 esac
