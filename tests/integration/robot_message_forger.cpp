@@ -12,9 +12,9 @@
 // its stop line), and another runner_id on them would not stop it (deploy_sim_robot.sh
 // foreign_runner_signed).
 // With --state, the same for every new state message robot 0 signs: the replay, and the state
-// changed (NaN joint angles, utime 10 s newer) signed with the actor's key and unsigned. A runner
-// that took a changed state leaves its policy: NaN angles give the safe command, and a utime from
-// the future makes every real state look old until the watchdog trips.
+// changed (NaN joint angles, or every other time the base rolled by 1 rad; utime 1 ms newer)
+// signed with the actor's key and unsigned. A runner that took a changed state leaves its policy:
+// NaN angles give the safe command, the roll the emergency stop.
 // With --future (no key needed), beside a runner signed or not: for every new command of the runner
 // it hears, the command changed as above (an emergency stop, 10 s newer) and unsigned, nothing else:
 // a robot that takes unsigned commands (--insecure) must refuse it by its clock (ahead_of_clock),
@@ -24,6 +24,7 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <vector>
@@ -106,8 +107,17 @@ int main(int argc, char** argv) {
         lcmt_robot_state st;
         if (transport::decodeChecked(copy.data(), body, st) != transport::WireVerdict::kOk) return;
         if (lcm.publishWire(on, copy.data(), size)) ++replays;
-        st.utime += 10000000;
-        for (auto& q : st.joint_position) q = std::numeric_limits<double>::quiet_NaN();
+        // 1 ms newer: inside the freshness lead, so that a runner that does not verify takes it.
+        st.utime += 1000;
+        // Every other one NaN joint angles, the others a base rolled by 1 rad (a fall, to an IMU).
+        if (replays % 2 == 0) {
+          for (auto& q : st.joint_position) q = std::numeric_limits<double>::quiet_NaN();
+        } else {
+          st.has_base = 1;
+          st.base_qw = std::cos(0.5);
+          st.base_qx = std::sin(0.5);
+          st.base_qy = st.base_qz = 0;
+        }
         if (as_actor.publish(on, st)) ++actor_signed;
         if (lcm.publish(on, st)) ++unsigned_sent;
         return;
