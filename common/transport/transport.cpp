@@ -45,7 +45,9 @@ SignedMode loadSignedMode(const std::string& roster_path, const std::string& key
 Transport::Transport(const std::string& url, const SignedMode& mode) : Transport(url) {
   if (!mode.roster) throw std::invalid_argument("masa transport: signed mode without a roster");
   signer_ = mode.signer;  // null: a watcher that verifies and never publishes (masa_lcm_probe --roster)
-  verifier_ = std::make_unique<MessageVerifier>(mode.roster);
+  // A log (file://) is recorded traffic: all of it from before this receiver started.
+  const bool recorded = url.rfind("file://", 0) == 0;
+  verifier_ = std::make_unique<MessageVerifier>(mode.roster, recorded ? 0 : static_cast<uint64_t>(wallClockMicros()));
 }
 
 Transport::~Transport() {

@@ -39,6 +39,7 @@ enum class WireVerdict : int {
   kClaimsAnotherSender,  // signed by one actor, claiming another's actor id
   kReplayed,             // its counter was taken before from this sender on this channel
   kBeyondWindow,         // its counter is more than kReplayWindow below the sender's newest
+  kBeforeStart,          // its counter (the sender's clock when it signed) is older than this receiver's start
   kCount
 };
 inline constexpr int kNumWireVerdicts = static_cast<int>(WireVerdict::kCount);

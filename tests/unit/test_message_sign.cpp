@@ -177,7 +177,7 @@ TEST(ReplayWindow, TakesEachCounterOnceInAnyOrderWithinTheWindowAndNothingBelowI
 
 TEST(MessageSign, ASignedMessageOpensForItsSenderOnItsChannelAndEveryChangeIsRefusedByReason) {
   SignedRun run(2, "trailer");
-  MessageVerifier verifier(run.roster);
+  MessageVerifier verifier(run.roster, 0);
   const std::vector<uint8_t> message = encode(samplePolicy());
   const std::vector<uint8_t> bytes = signedBytes(*run.learner, kPolicyChannel, message);
   ASSERT_EQ(bytes.size(), message.size() + 81);
