@@ -196,7 +196,8 @@ DropStats Learner::dropStats() const {
                                         std::pair{DropReason::kClaimsAnotherActor, WireVerdict::kClaimsAnotherSender},
                                         std::pair{DropReason::kReplayed, WireVerdict::kReplayed},
                                         std::pair{DropReason::kBeyondWindow, WireVerdict::kBeyondWindow},
-                                        std::pair{DropReason::kBeforeStart, WireVerdict::kBeforeStart}})
+                                        std::pair{DropReason::kBeforeStart, WireVerdict::kBeforeStart},
+                                        std::pair{DropReason::kAnotherRanksActor, WireVerdict::kAnotherRanksActor}})
     s.count[static_cast<int>(reason)] = refused[static_cast<int>(verdict)];
   return s;
 }

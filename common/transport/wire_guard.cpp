@@ -57,6 +57,7 @@ std::string_view wireVerdictName(WireVerdict v) {
     case WireVerdict::kReplayed: return "replayed";
     case WireVerdict::kBeyondWindow: return "beyond_window";
     case WireVerdict::kBeforeStart: return "before_start";
+    case WireVerdict::kAnotherRanksActor: return "another_ranks_actor";
     case WireVerdict::kCount: break;
   }
   return "unknown";

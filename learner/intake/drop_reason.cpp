@@ -22,6 +22,7 @@ std::string_view dropReasonName(DropReason r) {
     case DropReason::kReplayed: return "replayed";
     case DropReason::kBeyondWindow: return "beyond_window";
     case DropReason::kBeforeStart: return "before_start";
+    case DropReason::kAnotherRanksActor: return "another_ranks_actor";
     case DropReason::kLost: return "lost";
     case DropReason::kCount: break;
   }
