@@ -142,7 +142,7 @@ void signEach(benchmark::State& state, const std::vector<uint8_t>& message, cons
 
 void verifyEach(benchmark::State& state, const std::vector<uint8_t>& message, const char* channel, bool as_learner) {
   Keys keys;
-  const transport::MessageVerifier verifier(keys.roster);
+  const transport::MessageVerifier verifier(keys.roster, 0);
   std::vector<uint8_t> signed_bytes(message);
   signed_bytes.resize(message.size() + transport::kSigTrailerBytes);
   (as_learner ? *keys.learner : *keys.actor)

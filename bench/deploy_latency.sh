@@ -4,7 +4,8 @@
 # in one invocation, SECONDS each; optionally a training run (masa_train, pinned to the runner's
 # core) loads that core. For each variant it prints masa_deploy's own figure (state received ->
 # command published, p50 / p99, and its parts) and the source's round trip (state published ->
-# command received).
+# command received). The source sends unsigned state, so the runner runs --insecure (the figures
+# recorded before the robot channels were signed by default are of that path).
 #   bench/deploy_latency.sh [SECONDS] [--load]
 # Variants (MASA_BENCH_VARIANTS, default all): before (chrt -f 50 + taskset, the first recorded
 # setting), warm (before + realtime.warm_up_us), busy (before + realtime.busy_poll_us), after (the
@@ -44,7 +45,7 @@ for v in $variants; do
     *) echo "unknown variant $v"; exit 2 ;;
   esac
   "${run[@]}" "$build/deploy/masa_deploy" "$src/tasks/a1_beam/policy/policy.bin" \
-    --config "$src/configs/deploy/a1_beam_sim.yaml" --set emergency.max_roll=3 --set emergency.max_pitch=3 \
+    --config "$src/configs/deploy/a1_beam_sim.yaml" --insecure --set emergency.max_roll=3 --set emergency.max_pitch=3 \
     "${sets[@]}" --duration $((seconds + 2)) --quiet 2> "$log" & pids+=($!)
   sleep 0.5
   source_rt=()

@@ -16,7 +16,8 @@
 # RUN_DIR/keys/<role><index>.key (mode 0600), and RUN_DIR/roster says whose key may publish on which
 # channel (the learner's alone on MASA_POLICY, each actor's on its own rollouts and heartbeats), so a
 # stolen actor key can neither forge parameters nor another actor's rollouts; both are made here by
-# masa_roster before anything starts, kept on --resume, and with --hosts each host gets the roster
+# masa_roster before anything starts, kept on --resume (where the actors beyond --actors K leave the
+# roster: a run no longer believes actors it does not run), and with --hosts each host gets the roster
 # and only its own actors' keys, over the remote shell's stdin. With --ranks the MPI job's processes
 # make their keys in memory and gather the public keys over MPI (no key file). --auth hmac authenticates with one
 # run key, RUN_DIR/run.key, shared by all (any holder can forge anything; no replay protection);

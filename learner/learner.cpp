@@ -176,7 +176,9 @@ DropStats Learner::dropStats() const {
                                         std::pair{DropReason::kNotPermitted, WireVerdict::kNotPermitted},
                                         std::pair{DropReason::kClaimsAnotherActor, WireVerdict::kClaimsAnotherSender},
                                         std::pair{DropReason::kReplayed, WireVerdict::kReplayed},
-                                        std::pair{DropReason::kBeyondWindow, WireVerdict::kBeyondWindow}})
+                                        std::pair{DropReason::kBeyondWindow, WireVerdict::kBeyondWindow},
+                                        std::pair{DropReason::kBeforeStart, WireVerdict::kBeforeStart},
+                                        std::pair{DropReason::kAnotherRanksActor, WireVerdict::kAnotherRanksActor}})
     s.count[static_cast<int>(reason)] = refused[static_cast<int>(verdict)];
   return s;
 }

@@ -204,6 +204,9 @@ int main(int argc, char** argv) {
     }
     chooseAuthentication(opt, roster_file, signing_key, key_file, no_auth, signed_job ? &*job_keys : nullptr,
                          job != nullptr, lead);
+    // Each rank takes rollouts only from the actors that report to it (actor i: rank i mod ranks).
+    if (ranks && opt.signed_mode)
+      opt.signed_mode->rollout_share = {static_cast<uint32_t>(ranks->rank()), static_cast<uint32_t>(ranks->size())};
     if (ranks && !no_auth && !signed_job) {
       // Rank 0's key for the other ranks, over MPI: never on a command line or in a shared file.
       std::vector<uint8_t> key;

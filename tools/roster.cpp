@@ -5,6 +5,10 @@
 //                                                   with their public keys and the channels of each role
 //   masa_roster show ROSTER                          the senders, their key fingerprints and channels
 // make keeps what is there: a resumed run keeps its keys, and more actors get keys of their own.
+// With --actors given, actors beyond K leave the roster, their key files removed (issue #55, item 3): a run resumed with
+// fewer actors must not go on believing the ones it no longer runs, whose hosts still hold their
+// keys and whose recorded chunks would verify as current data. Brought back later, an actor index
+// gets a new key.
 // deploy/train.sh runs it before it starts anything and gives each process its own key file; the
 // private keys stay files, never on a command line.
 #include <CLI/CLI.hpp>
@@ -35,12 +39,27 @@ void writeRoster(const transport::Roster& roster, const fs::path& path) {
   fs::rename(tmp, path);  // appears whole
 }
 
-int make(const std::string& dir, int actors, bool runner, bool robot) {
+// The roster without actors of index `actors` and above, and their key files removed; returns how
+// many left.
+int retireActorsFrom(transport::Roster& roster, int actors, const fs::path& keys) {
+  std::vector<transport::SenderId> retired;
+  roster = roster.withoutActorsFrom(static_cast<uint32_t>(actors), retired);
+  for (const transport::SenderId& id : retired) {
+    const std::string stem = (keys / ("actor" + std::to_string(id.index))).string();
+    fs::remove(stem + ".key");
+    fs::remove(stem + ".pub");
+    std::printf("masa_roster: %s retired (the run has %d actors): it leaves the roster\n", id.name().c_str(), actors);
+  }
+  return static_cast<int>(retired.size());
+}
+
+int make(const std::string& dir, int actors, bool actors_given, bool runner, bool robot) {
   const fs::path run(dir), keys = run / "keys", roster_path = run / "roster";
   fs::create_directories(keys);
   ::chmod(keys.c_str(), 0700);
   transport::Roster roster;
   if (fs::exists(roster_path)) roster = transport::Roster::load(roster_path.string());
+  const int retired = actors_given ? retireActorsFrom(roster, actors, keys) : 0;
   std::vector<transport::SenderId> wanted = {{transport::Role::kLearner, 0}};
   for (int a = 0; a < actors; ++a) wanted.push_back({transport::Role::kActor, static_cast<uint32_t>(a)});
   if (runner) wanted.push_back({transport::Role::kRunner, 0});
@@ -53,9 +72,9 @@ int make(const std::string& dir, int actors, bool runner, bool robot) {
     roster.add(id, key, transport::defaultChannels(id.role));
     ++made;
   }
-  if (made > 0) writeRoster(roster, roster_path);
-  std::printf("masa_roster: %s: %zu senders (%d new keys under %s)\n", roster_path.c_str(), roster.entries().size(), made,
-              keys.c_str());
+  if (made > 0 || retired > 0) writeRoster(roster, roster_path);
+  std::printf("masa_roster: %s: %zu senders (%d new keys under %s, %d actors retired)\n", roster_path.c_str(),
+              roster.entries().size(), made, keys.c_str(), retired);
   return 0;
 }
 
@@ -80,14 +99,15 @@ int main(int argc, char** argv) {
   bool runner = false, robot = false;
   auto* make_cmd = app.add_subcommand("make", "make the keys and the roster of a run directory (keeps what is there)");
   make_cmd->add_option("run_dir", dir, "the run directory")->required();
-  make_cmd->add_option("--actors", actors, "actors of the run (keys actor0 .. actorK-1)")->check(CLI::Range(0, 1 << 20));
+  auto* actors_opt = make_cmd->add_option("--actors", actors, "actors of the run (keys actor0 .. actorK-1); actors beyond "
+                                          "leave the roster")->check(CLI::Range(0, 1 << 20));
   make_cmd->add_flag("--runner", runner, "a key for the robot's policy runner (masa_deploy), on the robot command channel");
   make_cmd->add_flag("--robot", robot, "a key for the robot (masa_sim_robot --signing-key), on the robot state channel");
   auto* show_cmd = app.add_subcommand("show", "the senders of a roster");
   show_cmd->add_option("roster", path, "a roster file")->required();
   CLI11_PARSE(app, argc, argv);
   try {
-    if (*make_cmd) return make(dir, actors, runner, robot);
+    if (*make_cmd) return make(dir, actors, actors_opt->count() > 0, runner, robot);
     return show(path);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_roster: %s\n", e.what());

@@ -1,5 +1,6 @@
 #include "common/transport/message_sign.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
@@ -65,7 +66,7 @@ MessageSigner::MessageSigner(integrity::SigningKey key, SenderId id, uint64_t fi
     : key_(std::move(key)),
       public_(key_.publicKey()),
       id_(id),
-      next_(first_counter != 0 ? first_counter : static_cast<uint64_t>(wallClockMicros())) {}
+      next_(first_counter) {}
 
 std::shared_ptr<MessageSigner> MessageSigner::load(const std::string& key_path, SenderId id, const Roster& roster) {
   integrity::SigningKey key = integrity::SigningKey::load(key_path);
@@ -80,7 +81,13 @@ std::shared_ptr<MessageSigner> MessageSigner::load(const std::string& key_path, 
 }
 
 void MessageSigner::seal(std::string_view channel, const void* message, int size, uint8_t* trailer) {
-  sealWithCounter(channel, message, size, next_.fetch_add(1), trailer);
+  // The clock, unless a message of this process already took that microsecond (or the clock stepped back).
+  const uint64_t now = static_cast<uint64_t>(std::max<int64_t>(0, wallClockMicros()));
+  uint64_t next = next_.load();
+  uint64_t counter = 0;
+  do counter = std::max(next, now);
+  while (!next_.compare_exchange_weak(next, counter + 1));
+  sealWithCounter(channel, message, size, counter, trailer);
 }
 
 void MessageSigner::sealWithCounter(std::string_view channel, const void* message, int size, uint64_t counter,
@@ -114,7 +121,8 @@ void ReplayWindow::accept(uint64_t counter) {
   if (below < static_cast<uint64_t>(kReplayWindow)) seen_.set(static_cast<std::size_t>(below));
 }
 
-MessageVerifier::MessageVerifier(std::shared_ptr<const Roster> roster) : roster_(std::move(roster)) {
+MessageVerifier::MessageVerifier(std::shared_ptr<const Roster> roster, uint64_t not_before_us)
+    : roster_(std::move(roster)), not_before_us_(not_before_us) {
   if (!roster_) throw std::invalid_argument("message verifier: no roster");
 }
 
@@ -149,6 +157,7 @@ OpenedMessage MessageVerifier::open(std::string_view channel, const void* data, 
 }
 
 WireVerdict MessageVerifier::fresh(std::string_view channel, const OpenedMessage& m) const {
+  if (m.counter < not_before_us_) return WireVerdict::kBeforeStart;
   const auto it = windows_.find({m.sender, std::string(channel)});
   return it == windows_.end() ? WireVerdict::kOk : it->second.check(m.counter);
 }

@@ -14,12 +14,15 @@
 //   - the signature verifies under the roster's key for that sender ................ unauthenticated
 //   - what the message claims to be from matches the signer (Transport: an actor's chunks and
 //     heartbeats name its own actor id) .............................................. claims_another_sender
+//   - the counter is not older than the receiver's start ................................ before_start
 //   - the counter is new for (sender, channel): not seen before ...................... replayed
 //     and not more than kReplayWindow below the highest seen ........................ beyond_window
 // and only a message that passes all of them moves the counter window: nothing a refused message
-// carries changes state. A process's counter starts at its start time in microseconds and goes up
-// by one per message on every channel, so a restarted process (same key) starts above its previous
-// life's counters as long as it sent fewer than a million messages a second.
+// carries changes state. A message's counter is the sender's wall clock in microseconds when it
+// signed it (one more than its previous counter when the clock has not moved on), so a restarted
+// process (same key) starts above its previous life's counters, and a receiver refuses whatever
+// was signed before it started (issue #55, item 3): without that, a receiver that restarted took a
+// sender's recorded history once, in order, since its empty window accepted any counter.
 #pragma once
 
 #include <atomic>
@@ -46,10 +49,11 @@ inline constexpr int kSigTrailerBytes = kSigHeaderBytes + kSigBytes;  // 81
 // (reordered by the network) and be taken once.
 inline constexpr int kReplayWindow = 1024;
 
-// Thread-safe: publish() may sign from several threads; each message gets its own counter.
+// Thread-safe: publish() may sign from several threads; each message gets its own counter, the wall
+// clock in microseconds or one above the previous counter, whichever is higher.
 class MessageSigner {
  public:
-  // `first_counter` 0: the wall clock in microseconds.
+  // `first_counter`: the lowest counter it signs with (0: none, the wall clock alone).
   MessageSigner(integrity::SigningKey key, SenderId id, uint64_t first_counter = 0);
   // Reads a private key file (integrity::SigningKey::load) and checks that the roster lists its
   // public key for `id`: throws std::runtime_error otherwise.
@@ -63,6 +67,7 @@ class MessageSigner {
 
   SenderId id() const { return id_; }
   const integrity::PublicKeyBytes& publicKey() const { return public_; }
+  // The lowest counter the next message may get (the clock may give it a higher one).
   uint64_t nextCounter() const { return next_.load(); }
 
  private:
@@ -98,10 +103,12 @@ struct OpenedMessage {
 // One receiver's checks. Not thread-safe: one per Transport, used on its handling thread.
 class MessageVerifier {
  public:
-  explicit MessageVerifier(std::shared_ptr<const Roster> roster);
+  // Refuses counters below `not_before_us` (before_start): the receiver's start on the wall clock;
+  // 0 for a receiver of recorded traffic (an LCM log), where every message is from before.
+  MessageVerifier(std::shared_ptr<const Roster> roster, uint64_t not_before_us);
   // Trailer, sender, permission and signature; changes nothing.
   OpenedMessage open(std::string_view channel, const void* data, int size) const;
-  // The counter against (sender, channel)'s window; changes nothing.
+  // The counter against the receiver's start and (sender, channel)'s window; changes nothing.
   WireVerdict fresh(std::string_view channel, const OpenedMessage& m) const;
   // Moves the window: for a message every check passed.
   void accept(std::string_view channel, const OpenedMessage& m);
@@ -109,6 +116,7 @@ class MessageVerifier {
 
  private:
   std::shared_ptr<const Roster> roster_;
+  uint64_t not_before_us_;
   std::map<std::pair<SenderId, std::string>, ReplayWindow> windows_;
 };
 

@@ -79,6 +79,15 @@ void Roster::add(SenderId id, const integrity::PublicKeyBytes& key, std::vector<
   entries_.push_back(std::move(e));
 }
 
+Roster Roster::withoutActorsFrom(uint32_t actors, std::vector<SenderId>& retired) const {
+  Roster kept(source_);
+  for (const Entry& e : entries_) {
+    if (e.id.role == Role::kActor && e.id.index >= actors) retired.push_back(e.id);
+    else kept.entries_.push_back(e);
+  }
+  return kept;
+}
+
 const Roster::Entry* Roster::find(SenderId id) const {
   for (const Entry& e : entries_)
     if (e.id == id) return &e;

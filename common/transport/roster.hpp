@@ -67,6 +67,10 @@ class Roster {
   // The sender's entry, or nullptr when the roster does not list it.
   const Entry* find(SenderId id) const;
   static bool permits(const Entry& entry, std::string_view channel);
+  // The roster without the actors of index `actors` and above, whose ids go to `retired` (a run
+  // resumed with fewer actors: the others leave it, so that their recorded chunks, and their
+  // hosts that still hold their keys, are refused as unknown senders; issue #55, item 3).
+  Roster withoutActorsFrom(uint32_t actors, std::vector<SenderId>& retired) const;
   const std::vector<Entry>& entries() const { return entries_; }
   const std::string& source() const { return source_; }
   // The file's text: what load() reads back.

@@ -44,8 +44,11 @@ SignedMode loadSignedMode(const std::string& roster_path, const std::string& key
 
 Transport::Transport(const std::string& url, const SignedMode& mode) : Transport(url) {
   if (!mode.roster) throw std::invalid_argument("masa transport: signed mode without a roster");
+  rollout_share_ = mode.rollout_share;
   signer_ = mode.signer;  // null: a watcher that verifies and never publishes (masa_lcm_probe --roster)
-  verifier_ = std::make_unique<MessageVerifier>(mode.roster);
+  // A log (file://) is recorded traffic: all of it from before this receiver started.
+  const bool recorded = url.rfind("file://", 0) == 0;
+  verifier_ = std::make_unique<MessageVerifier>(mode.roster, recorded ? 0 : static_cast<uint64_t>(wallClockMicros()));
 }
 
 Transport::~Transport() {
@@ -132,6 +135,10 @@ OpenedMessage Transport::openSigned(const char* channel, const void* data, int s
   OpenedMessage m = verifier_->open(channel, data, size);
   if (m.verdict == WireVerdict::kOk && claimsAnother(channel, m.sender, static_cast<const uint8_t*>(data), m.size))
     m.verdict = WireVerdict::kClaimsAnotherSender;
+  // An actor's chunk is for its own learner rank alone; before the counter, so that it moves no window.
+  if (m.verdict == WireVerdict::kOk && std::string_view(channel) == kRolloutChannel &&
+      m.sender.role == Role::kActor && !rollout_share_.takes(m.sender.index))
+    m.verdict = WireVerdict::kAnotherRanksActor;
   if (m.verdict == WireVerdict::kOk) m.verdict = verifier_->fresh(channel, m);
   if (m.verdict == WireVerdict::kOk) verifier_->accept(channel, m);
   last_verdict_ = {dispatch_, data, size, m};

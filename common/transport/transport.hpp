@@ -45,11 +45,21 @@ int64_t wallClockMicros();
 // (about 15% of them in a 2-actor run on this machine); 2048 chunks of 60 KB are about 120 MB.
 inline constexpr int kSubscriptionQueueCapacity = 2048;
 
+// Whose rollout chunks a receiver takes (issue #55, item 3): in an MPI job actor i reports to
+// learner rank i mod ranks, and each rank takes only its own share. Without it, a chunk signed for
+// rank 1 and copied to rank 0's URL verified there (the signature names the channel, not the rank)
+// and was taken as current data.
+struct ActorShare {
+  uint32_t rank = 0, ranks = 1;  // ranks 1: every actor
+  bool takes(uint32_t actor) const { return ranks <= 1 || actor % ranks == rank; }
+};
+
 // A process's signing identity in a signed run: its signer (shared by the process's transports,
-// so that its counter runs over all of them) and the run's roster.
+// so that its counter runs over all of them), the run's roster, and the actors whose rollouts it takes.
 struct SignedMode {
   std::shared_ptr<MessageSigner> signer;
   std::shared_ptr<const Roster> roster;
+  ActorShare rollout_share;
 };
 
 // The roster file and this process's private key file (never the key itself on a command line):
@@ -128,6 +138,7 @@ class Transport : public MessageBus {
   std::string key_id_;                           // RunKey::id(), for the warnings
   std::shared_ptr<MessageSigner> signer_;     // null: not signed
   std::unique_ptr<MessageVerifier> verifier_;  // signed runs (with signer_, or alone for a watcher)
+  ActorShare rollout_share_;
   std::optional<SenderId> current_sender_;
   uint64_t dispatch_ = 0;  // LCM dispatches so far (handleTimeout, drain)
   struct Verdict {

@@ -56,6 +56,8 @@ std::string_view wireVerdictName(WireVerdict v) {
     case WireVerdict::kClaimsAnotherSender: return "claims_another_sender";
     case WireVerdict::kReplayed: return "replayed";
     case WireVerdict::kBeyondWindow: return "beyond_window";
+    case WireVerdict::kBeforeStart: return "before_start";
+    case WireVerdict::kAnotherRanksActor: return "another_ranks_actor";
     case WireVerdict::kCount: break;
   }
   return "unknown";

@@ -39,6 +39,8 @@ enum class WireVerdict : int {
   kClaimsAnotherSender,  // signed by one actor, claiming another's actor id
   kReplayed,             // its counter was taken before from this sender on this channel
   kBeyondWindow,         // its counter is more than kReplayWindow below the sender's newest
+  kBeforeStart,          // its counter (the sender's clock when it signed) is older than this receiver's start
+  kAnotherRanksActor,    // a rollout chunk of an actor that reports to another learner rank of the MPI job
   kCount
 };
 inline constexpr int kNumWireVerdicts = static_cast<int>(WireVerdict::kCount);

@@ -9,14 +9,17 @@
 // the robot to its own command timeout (docs/reliability.md, "The robot's side").
 // --require-signed --trusted-keys KEYS refuses a policy file not signed by one of the Ed25519 public
 // keys in KEYS (a .pub file, or a directory of them; masa_seal keygen / sign make them).
-// --roster ROSTER --signing-key KEY signs every command as `runner 0` of the roster (masa_roster make
-// DIR --runner makes DIR/roster and DIR/keys/runner0.key), for a robot side that verifies commands
-// (masa_sim_robot --roster ROSTER). --verify-state (with --roster) takes only state signed by robot 0
-// of the roster and new (its counter window), refusing the rest by reason (masa_roster make DIR
-// --robot; masa_sim_robot --signing-key DIR/keys/robot0.key); without it the state is read unsigned.
-// With --roster the start guard and the watch for other runners hear only commands a sender of the
-// roster signed (runner 0, a new counter); the rest are refused and counted. Without it they hear
-// every command unverified and err towards stopping (deploy/runner/foreign_runners.hpp).
+// The robot channels are signed by default (issue #55, item 2): --roster ROSTER --signing-key KEY
+// (masa_roster make DIR --runner --robot makes DIR/roster, DIR/keys/runner0.key and robot0.key)
+// signs every command as `runner 0` of the roster, for a robot side that verifies commands
+// (masa_sim_robot --roster ROSTER), and takes only state signed by robot 0 of the roster and new
+// (its counter window), refusing the rest by reason (masa_sim_robot --signing-key
+// DIR/keys/robot0.key). The start guard and the watch for other runners hear only commands a
+// sender of the roster signed (runner 0, a new counter); the rest are refused and counted.
+// --insecure is the explicit way out, for a robot whose bridge neither signs nor verifies: commands
+// unsigned, state and other runners' commands heard unverified (a signer's trailer cut off), and
+// the watch errs towards stopping (deploy/runner/foreign_runners.hpp). Without either, it refuses
+// to start (exit 2), naming both.
 // Exit codes: 0 stopped (signal, --duration, --max-policy-steps), 2 error (in the control loop:
 // after the safe command), 3 start guard refused or another runner appeared (then after the safe
 // command), 4 stopped by the watchdog or the emergency stop (--exit-on-trip).
@@ -148,7 +151,7 @@ struct DeployArgs {
   std::vector<std::string> sets;
   double duration_s = 0;
   int64_t max_policy_steps = 0;
-  bool quiet = false, exit_on_trip = false, require_signed = false, verify_state = false;
+  bool quiet = false, exit_on_trip = false, require_signed = false, verify_state = false, insecure = false;
   std::string trusted_keys_path, roster_file, signing_key;
 };
 
@@ -171,19 +174,28 @@ int parseArgs(int argc, char** argv, DeployArgs& a) {
   app.add_option("--trusted-keys", a.trusted_keys_path, "Ed25519 public key file (PEM), or a directory of *.pub files")
       ->check(CLI::ExistingPath);
   auto* roster_opt = app.add_option("--roster", a.roster_file,
-                                    "sign every command as runner 0 of this roster (masa_roster make DIR --runner), for "
-                                    "a robot side that verifies commands");
+                                    "sign every command as runner 0 of this roster and take only state signed by its "
+                                    "robot 0 (masa_roster make DIR --runner --robot)");
   auto* key_opt = app.add_option("--signing-key", a.signing_key, "the runner's private key file (mode 0600), with --roster");
   roster_opt->needs(key_opt);
   key_opt->needs(roster_opt);
-  app.add_flag("--verify-state", a.verify_state,
-               "take only state messages signed by robot 0 of --roster (masa_roster make DIR --robot), refuse the rest")
-      ->needs(roster_opt);
+  auto* verify_opt = app.add_flag("--verify-state", a.verify_state, "the default with --roster (kept for earlier command lines)")
+                         ->needs(roster_opt);
+  app.add_flag("--insecure", a.insecure,
+               "unsigned commands, unverified state: anyone on the robot's network can command the robot")
+      ->excludes(roster_opt)->excludes(key_opt)->excludes(verify_opt);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  if (!a.insecure && a.roster_file.empty()) {
+    std::fprintf(stderr, "masa_deploy: the robot channels are signed: give --roster DIR/roster --signing-key "
+                         "DIR/keys/runner0.key (masa_roster make DIR --runner --robot; the robot signs with "
+                         "DIR/keys/robot0.key), or --insecure for a robot that neither signs nor verifies\n");
+    return 2;
+  }
+  a.verify_state = !a.insecure;
   if (a.require_signed != !a.trusted_keys_path.empty()) {
     std::fprintf(stderr, a.require_signed ? "masa_deploy: --require-signed needs --trusted-keys (the public keys a policy may be signed by)\n"
                                           : "masa_deploy: --trusted-keys is used with --require-signed (say both)\n");
@@ -205,7 +217,7 @@ policy::LoadedPolicy loadCheckedPolicy(const DeployArgs& a) {
   return lp;
 }
 
-// Signed commands (opt-in): the key must be the one the roster gives runner 0.
+// Signed commands (the default): the key must be the one the roster gives runner 0.
 std::shared_ptr<transport::MessageSigner> loadCommandSigner(const DeployArgs& a) {
   if (a.roster_file.empty()) return nullptr;
   auto signer = transport::loadSignedMode(a.roster_file, a.signing_key, {transport::Role::kRunner, 0}).signer;
@@ -222,12 +234,13 @@ std::unique_ptr<transport::Transport> openWatcher(std::shared_ptr<const transpor
   return std::make_unique<transport::Transport>(url, watch);
 }
 
-// Verified state (opt-in) comes through a watcher of its own.
+// Verified state (the default) comes through a watcher of its own.
 std::unique_ptr<transport::Transport> openVerifyingTransport(const DeployArgs& a, const std::string& url) {
   if (!a.verify_state) return nullptr;
   auto roster = std::make_shared<transport::Roster>(transport::Roster::load(a.roster_file));
   if (!roster->find({transport::Role::kRobot, 0}))
-    throw std::runtime_error("--verify-state: the roster " + a.roster_file + " names no robot 0 (masa_roster make DIR --robot)");
+    throw std::runtime_error("the roster " + a.roster_file + " names no robot 0 to take the state from (masa_roster make DIR "
+                             "--robot), or --insecure");
   auto verifying = openWatcher(std::move(roster), url);
   std::fprintf(stderr, "masa_deploy: state taken only signed by robot 0 of %s\n", a.roster_file.c_str());
   return verifying;
@@ -418,6 +431,11 @@ int main(int argc, char** argv) {
     std::unique_ptr<transport::Transport> verifying = openVerifyingTransport(a, url);
     std::unique_ptr<transport::Transport> command_watcher = openCommandWatcher(a, url, cfg.command_channel);
     printStartLine(lp, sym_error, runner, cfg, runner_id, scheduling);
+    if (a.insecure)
+      std::fprintf(stderr, "masa_deploy: --insecure: commands unsigned, state and other runners' commands unverified: "
+                           "anyone who can publish on %s commands the robot with any gains and targets, and any state "
+                           "reaches the policy\n",
+                   cfg.command_channel.c_str());
 
     Links links{lcm, verifying.get(), command_watcher.get(), commands, {}, 0};
     links.foreign.listen(command_watcher ? *command_watcher : lcm, cfg.command_channel, runner.makeCommand(), runner_id);
@@ -427,6 +445,8 @@ int main(int argc, char** argv) {
     state.joint_torque.reserve(runner.numJoints());
     links.stateIn().subscribeRaw(cfg.state_channel, [&](const void* data, int size) {
       const int64_t rx = steadyMicros();
+      // --insecure: a signing robot's trailer is not part of the state (verified: already cut off).
+      if (!verifying) size = transport::sizeWithoutSigTrailer(data, size);
       if (transport::decodeChecked(data, size, state) != transport::WireVerdict::kOk) {
         ++links.rejected_states;
         return;

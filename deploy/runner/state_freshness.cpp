@@ -13,7 +13,7 @@ StateFreshness::StateFreshness(int64_t max_lead_us, int resync_after)
 void StateFreshness::takeAsBaseline(int64_t utime, int64_t rx_us) {
   have_ = true;
   last_utime_ = utime;
-  best_offset_ = static_cast<__int128>(utime) - rx_us;
+  base_offset_ = static_cast<__int128>(utime) - rx_us;
   run_length_ = 0;
 }
 
@@ -25,10 +25,9 @@ StateFreshness::Verdict StateFreshness::judge(int64_t utime, int64_t rx_us) {
   // 128 bits: a hostile utime may be anything, and differences of int64 values overflow.
   const __int128 offset = static_cast<__int128>(utime) - rx_us;
   const bool newer = utime > last_utime_;
-  const bool within_lead = offset <= best_offset_ + max_lead_us_;
+  const bool within_lead = offset <= base_offset_ + max_lead_us_;
   if (newer && within_lead) {
-    last_utime_ = utime;
-    best_offset_ = std::max(best_offset_, offset);
+    last_utime_ = utime;  // the baseline's offset stays: taken states do not move the lead
     run_length_ = 0;
     return Verdict::kNew;
   }

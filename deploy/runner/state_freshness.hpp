@@ -9,7 +9,14 @@
 // but consistent among themselves (each utime advancing no faster than the receive clock, plus the
 // lead) are counted, and after `resync_after` of them in a row the newest becomes the new baseline.
 // One datagram cannot do that; a sender that keeps injecting consistent states can, but such a
-// sender can drive the policy anyway on an unsigned channel (masa_deploy --verify-state signs it).
+// sender can drive the policy anyway on an unsigned channel (masa_deploy verifies the robot's
+// signature unless --insecure).
+//
+// The lead is measured from the baseline's offset (utime - receive time), which only a resync
+// moves: a state taken inside the lead does not raise it (issue #55, item 2). Before, every state
+// taken raised it to its own offset, so forged states interleaved with the real ones, each one
+// lead ahead of the last, walked it forward without end and every real state became a repeat. A
+// robot clock that drifts ahead of ours leaves the lead after a while and is resynced like a step.
 #pragma once
 
 #include <cstdint>
@@ -43,7 +50,7 @@ class StateFreshness {
   int resync_after_;
   bool have_ = false;
   int64_t last_utime_ = 0;
-  __int128 best_offset_ = 0;  // max of utime - rx over the states taken since the baseline
+  __int128 base_offset_ = 0;  // utime - rx of the baseline: the lead counts from here
   // The current run of refused states: its newest, and how many in a row were consistent.
   int64_t run_utime_ = 0, run_rx_us_ = 0;
   int run_length_ = 0;

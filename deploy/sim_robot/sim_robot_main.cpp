@@ -13,12 +13,16 @@
 // both report when the first safe command (mode >= 2) arrived after the fault; --tilt-state-after S
 // reports the base rolled by --tilt-rad more than it is (an IMU's view of a fall), and the robot
 // then reports its final joint angles and the fastest target change between emergency-stop commands.
-// --roster ROSTER: a robot side that verifies (issue #33, item 2): it takes a command only when it is
-// signed by a sender the roster lets publish on the command channel (runner 0, masa_roster make DIR
-// --runner; masa_deploy --roster --signing-key) and is new (counter window); others are refused and
-// counted by reason, printed at the end. Without it, commands are taken signed or not (unverified).
-// --signing-key DIR/keys/robot0.key (with --roster; masa_roster make DIR --robot): every state message
-// is signed as robot 0, for a runner that verifies the state (masa_deploy --verify-state).
+// Signed by default (issue #55, item 2): --roster ROSTER --signing-key DIR/keys/robot0.key
+// (masa_roster make DIR --runner --robot). It takes a command only when it is signed by a sender the
+// roster lets publish on the command channel (runner 0; masa_deploy --roster --signing-key) and is
+// new (counter window); others are refused and counted by reason, printed at the end. Every state
+// message is signed as robot 0, for the runner, which verifies it. --insecure instead: commands
+// taken signed or not (the trailer cut off unverified), state unsigned. Without either it refuses
+// to start (exit 2).
+// A command whose utime is ahead of the robot's wall clock by more than --command-lead-ms (100 ms)
+// is refused and counted (ahead_of_clock): the newest command wins, so one stamped far in the future
+// would pin the robot (deploy/sim_robot/command_lead.hpp).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -36,6 +40,7 @@
 #include "common/transport/channels.hpp"
 #include "common/transport/signed_publisher.hpp"
 #include "common/transport/transport.hpp"
+#include "deploy/sim_robot/command_lead.hpp"
 #include "deploy/sim_robot/command_link.hpp"
 #include "deploy/sim_robot/command_timeout.hpp"
 #include "deploy/sim_robot/run_record.hpp"
@@ -64,7 +69,7 @@ int main(int argc, char** argv) {
   double tilt_state_after = -1, tilt_rad = 1.0;
   int state_every = 1;
   bool quiet = false;
-  double command_timeout_ms = 150, damping_kd = 2.0;
+  double command_timeout_ms = 150, damping_kd = 2.0, command_lead_ms = 100;
   app.add_option("policy", policy_path, "policy file: its task is built exactly as trained")->required()->check(CLI::ExistingFile);
   app.add_option("--seed", seed, "the task resets from this seed (masa_eval's episode 0 of --seed)")->capture_default_str();
   app.add_option("--duration", duration, "seconds of simulated time after the first command")->capture_default_str()
@@ -87,14 +92,28 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--damping-kd", damping_kd, "kd of the robot's own damping (N m s / rad; the runner's safe.damping_kd)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--command-lead-ms", command_lead_ms,
+                 "refuse a command whose utime is ahead of this robot's clock by more than this")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
   std::string roster_file;
-  app.add_option("--roster", roster_file,
-                 "take only commands signed by a sender this roster permits on the command channel (runner 0)");
+  auto* roster_opt = app.add_option("--roster", roster_file,
+                                    "take only commands signed by a sender this roster permits on the command channel "
+                                    "(runner 0)");
   std::string signing_key;
-  app.add_option("--signing-key", signing_key,
-                 "sign every state message as robot 0 of --roster with this private key (masa_roster make DIR --robot)")
-      ->needs("--roster");
+  auto* key_opt = app.add_option("--signing-key", signing_key,
+                                 "sign every state message as robot 0 of --roster with this private key (masa_roster "
+                                 "make DIR --robot)");
+  roster_opt->needs(key_opt);
+  key_opt->needs(roster_opt);
+  bool insecure = false;
+  app.add_flag("--insecure", insecure, "take unsigned commands, send unsigned state: anyone on the network commands the robot")
+      ->excludes(roster_opt)->excludes(key_opt);
   CLI11_PARSE(app, argc, argv);
+  if (!insecure && roster_file.empty()) {
+    std::fprintf(stderr, "masa_sim_robot: the robot channels are signed: give --roster DIR/roster --signing-key "
+                         "DIR/keys/robot0.key (masa_roster make DIR --runner --robot), or --insecure\n");
+    return 2;
+  }
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
 
@@ -107,12 +126,15 @@ int main(int argc, char** argv) {
     deploy::SimRobot robot(*task, lp.spec);
     const int n = robot.numJoints();
     const deploy::StateFaults state_faults{nan_state_after, tilt_state_after, tilt_rad};
+    if (insecure)
+      std::fprintf(stderr, "masa_sim_robot: --insecure: commands taken unverified, state unsigned: anyone who can "
+                           "publish on %s commands the robot\n", command_channel.c_str());
 
     transport::Transport lcm(url);
-    // With a roster, commands arrive through a transport that verifies every message (and cannot
-    // publish: the state goes out unsigned through `lcm`).
+    // Signed, commands arrive through a transport that verifies every message (and cannot publish:
+    // the state goes out through `lcm`, signed by state_out).
     std::unique_ptr<transport::Transport> verifying;
-    if (!roster_file.empty()) {
+    if (!insecure) {
       transport::SignedMode watch;
       watch.roster = std::make_shared<transport::Roster>(transport::Roster::load(roster_file));
       verifying = std::make_unique<transport::Transport>(url, watch);
@@ -121,7 +143,7 @@ int main(int argc, char** argv) {
     }
     transport::Transport& command_in = verifying ? *verifying : lcm;
     std::shared_ptr<transport::MessageSigner> state_signer;
-    if (!signing_key.empty()) {
+    if (!insecure) {
       state_signer = transport::loadSignedMode(roster_file, signing_key, {transport::Role::kRobot, 0}).signer;
       std::fprintf(stderr, "masa_sim_robot: state signed as robot 0 with %s\n", signing_key.c_str());
     }
@@ -129,6 +151,7 @@ int main(int argc, char** argv) {
     deploy::CommandLink link(loss, delay_ms, jitter_ms, fault_seed);
     deploy::RunRecord record(*task);
     deploy::CommandTimeout command_timeout(command_timeout_ms * 1e-3, damping_kd, n);
+    deploy::CommandLead command_lead(static_cast<int64_t>(command_lead_ms * 1e3));
     if (command_timeout_ms > 0)
       std::fprintf(stderr, "masa_sim_robot: no command for %.0f ms: the robot damps itself (kp 0, kd %g)\n",
                    command_timeout_ms, damping_kd);
@@ -140,6 +163,7 @@ int main(int argc, char** argv) {
       // trailer is not part of the command.
       if (!verifying) size = transport::sizeWithoutSigTrailer(data, size);
       if (transport::decodeChecked(data, size, incoming) != transport::WireVerdict::kOk || incoming.num_joints != n) return;
+      if (!command_lead.admits(incoming.utime, transport::wallClockMicros())) return;  // counted; changes nothing
       record.commandArrived(incoming);
       const double now = wall();
       if (link.receive(incoming, now)) command_timeout.arrived(incoming, now);
@@ -193,6 +217,8 @@ int main(int argc, char** argv) {
     robot.updateKinematics();
     const std::vector<double> angles = robot.jointAngles();
     const std::string refused = verifying ? verifying->rejectSummary() : "";
+    std::printf("masa_sim_robot: commands refused after decoding: ahead_of_clock %lld (utime more than %.0f ms ahead of "
+                "the robot's clock)\n", static_cast<long long>(command_lead.refused()), command_lead_ms);
     record.print(steps * dt, link.lostCommands(), link.lostStates(), verifying ? refused.c_str() : nullptr,
                  tilt_state_after >= 0 ? &angles : nullptr, command_timeout);
     return 0;

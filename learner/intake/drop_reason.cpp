@@ -21,6 +21,8 @@ std::string_view dropReasonName(DropReason r) {
     case DropReason::kClaimsAnotherActor: return "claims_another_actor";
     case DropReason::kReplayed: return "replayed";
     case DropReason::kBeyondWindow: return "beyond_window";
+    case DropReason::kBeforeStart: return "before_start";
+    case DropReason::kAnotherRanksActor: return "another_ranks_actor";
     case DropReason::kLost: return "lost";
     case DropReason::kCount: break;
   }

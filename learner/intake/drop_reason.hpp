@@ -30,6 +30,8 @@ enum class DropReason : int {
   kClaimsAnotherActor,   // signed by one actor, naming another actor id
   kReplayed,             // a counter this actor used before on this channel
   kBeyondWindow,         // a counter too far below this actor's newest
+  kBeforeStart,          // signed before this learner started: a recording replayed after a restart
+  kAnotherRanksActor,    // an actor that reports to another learner rank of the MPI job
   // Never a verdict: chunks that never arrived (UDP loss, a full receive buffer, an actor killed
   // while sending), counted by the assembler from the gaps in each actor's rollout numbering.
   kLost,

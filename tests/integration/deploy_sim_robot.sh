@@ -17,14 +17,14 @@
 #   refusals      the shipped TriFinger Lift, Ant Acrobatic and Humanoid Dribbling policies are
 #                 refused with their configs, naming the object the robot cannot measure
 #   signed_commands  the runner signs its commands as runner 0 of a roster (masa_roster make --runner)
-#                 and the robot verifies them (--roster): it walks under the runner's commands while a
+#                 and the robot verifies them (both by default): it walks under the runner's commands while a
 #                 forger's replays, changed commands (an emergency stop) signed with an actor's key of
 #                 the roster and unsigned ones are refused and counted (replayed, not_permitted,
-#                 unauthenticated) and none is taken (no physics step in mode 4); a robot that does not verify takes the signed commands too; a verifying
-#                 robot refuses every command of an unsigned runner and never moves
-#   foreign_runner  one unsigned command with another runner_id stops the runner (exit 3), and the
+#                 unauthenticated) and none is taken (no physics step in mode 4); a verifying robot
+#                 refuses every command of an --insecure (unsigned) runner and never moves
+#   foreign_runner  one unsigned command with another runner_id stops an --insecure runner (exit 3), and the
 #                 last command it published is the safe command
-#   foreign_runner_signed  a signing runner (--roster) refuses and counts an unsigned and an
+#   foreign_runner_signed  a signing runner (the default) refuses and counts an unsigned and an
 #                 actor-signed foreign command and goes on; one signed with the runner key stops it
 #                 (exit 3) with the safe command
 #   safe_stop     --duration, SIGTERM, SIGHUP and SIGINT end the run (exit 0) with the safe command
@@ -32,9 +32,14 @@
 #   command_timeout  the runner is killed (no safe command): the robot damps itself within its
 #                 command timeout (150 ms default, and --command-timeout-ms 100)
 #   signed_state  the robot signs its state as robot 0 (masa_roster make --robot; masa_sim_robot
-#                 --signing-key) and the runner verifies it (--verify-state): it walks the robot while
-#                 a forger's replayed, actor-signed and unsigned states (NaN angles, a utime from the
-#                 future) are refused and counted; the same forger trips a runner that does not verify
+#                 --signing-key) and the runner verifies it (both by default): it walks the robot while
+#                 a forger's replayed, actor-signed and unsigned states (NaN angles or a 1 rad roll,
+#                 a utime from the future) are refused and counted; the same forger trips an
+#                 --insecure runner
+#   future_command  beside the runner, a forger sends each of its commands again changed (an
+#                 emergency stop) and stamped 10 s ahead, unsigned, to a robot that takes unsigned
+#                 commands: the robot refuses them by its clock (ahead_of_clock), spends no physics
+#                 step in mode 4 and walks under the runner
 # A real-time runner on a loaded machine can miss its state for 50 ms and trip its watchdog, which is
 # the watchdog doing its job, not what these cases test: walk, walk_tuned, faults and crouch (and
 # stale and nan, for a trip before their fault) say such a run and try it once more; a second trip
@@ -65,7 +70,14 @@ fail() {
   for f in "$work"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -n 20 "$f"; }; done
   exit 1
 }
-for b in "$deploy" "$sim" "$eval_bin"; do [ -x "$b" ] || fail "$b is missing: build first"; done
+roster_bin="$build/tools/masa_roster"
+for b in "$deploy" "$sim" "$eval_bin" "$roster_bin"; do [ -x "$b" ] || fail "$b is missing: build first"; done
+# The robot channels are signed by default (issue #55, item 2): every case signs them with the keys
+# of one roster (runner 0, robot 0, and actor 0 for the forgers), unless it says --insecure.
+"$roster_bin" make "$work/keys" --actors 1 --runner --robot > "$work/roster.log" 2>&1 || fail "masa_roster make failed"
+roster="$work/keys/roster"
+robot_keys=(--roster "$roster" --signing-key "$work/keys/keys/robot0.key")
+runner_keys=(--roster "$roster" --signing-key "$work/keys/keys/runner0.key")
 # le A B: A <= B (floating point)
 le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a <= b) }'; }
 # retry_after_stale_trip ATTEMPT [WHEN]: after a run, a stale-state watchdog trip in deploy.log (see
@@ -88,8 +100,8 @@ drive() {
   # A watchdog trip for stale state on a loaded machine is said and tried once more (see faults).
   local attempt rc trip
   for attempt in 1 2; do
-    "$sim" "$policy" --seed 0 --duration "$seconds" --quiet > "$work/sim.log" 2>&1 & pids+=($!)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" "$@" --max-policy-steps "$steps" --exit-on-trip --quiet \
+    "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration "$seconds" --quiet > "$work/sim.log" 2>&1 & pids+=($!)
+    timeout -s INT 20 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" "$@" --max-policy-steps "$steps" --exit-on-trip --quiet \
       > "$work/deploy.log" 2>&1
     rc=$?
     [ $rc -eq 4 ] && kill -INT "${pids[-1]}" 2> /dev/null
@@ -129,9 +141,9 @@ faults)
   # steps), the robot is stopped, and the run is said and tried once more; any other trip or
   # failure, or a second trip, fails.
   for attempt in 1 2; do
-    "$sim" "$policy" --seed 0 --duration 6.5 --quiet --delay-ms 4 --jitter-ms 4 --loss 0.05 --fault-seed 1 \
+    "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 6.5 --quiet --delay-ms 4 --jitter-ms 4 --loss 0.05 --fault-seed 1 \
       > "$work/sim.log" 2>&1 & pids+=($!)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" --max-policy-steps $steps --exit-on-trip --quiet \
+    timeout -s INT 20 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --max-policy-steps $steps --exit-on-trip --quiet \
       > "$work/deploy.log" 2>&1
     rc=$?
     [ $rc -eq 4 ] && kill -INT "${pids[-1]}" 2> /dev/null
@@ -156,9 +168,9 @@ stale|nan)
   else fault=(--nan-state-after 1.5); bound_s=0.05; want="state not finite"; fi
   # A trip before the fault (stale state on a loaded machine) is said and tried once more.
   for attempt in 1 2; do
-    "$sim" "$policy" --seed 0 --duration 3 --quiet "${fault[@]}" > "$work/sim.log" 2>&1 & pids+=($!)
+    "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 3 --quiet "${fault[@]}" > "$work/sim.log" 2>&1 & pids+=($!)
     # A runner that never trips would run on: timeout ends it (rc 124).
-    timeout -s INT 10 "$deploy" "$policy" --config "$config" --exit-on-trip --quiet > "$work/deploy.log" 2>&1
+    timeout -s INT 10 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --exit-on-trip --quiet > "$work/deploy.log" 2>&1
     rc=$?
     wait "${pids[-1]}"
     early=$(grep -m1 "first safe command .* came before it" "$work/sim.log") || break
@@ -175,10 +187,10 @@ stale|nan)
   echo "PASS: $case_name state: damping applied $after s after the fault (bound $bound_s s)"
   ;;
 second_runner)
-  "$sim" "$policy" --seed 0 --duration 4 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
-  "$deploy" "$policy" --config "$config" --duration 3 --quiet > "$work/first.log" 2>&1 & pids+=($!)
+  "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 4 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
+  "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --duration 3 --quiet > "$work/first.log" 2>&1 & pids+=($!)
   sleep 1.5
-  timeout -s INT 5 "$deploy" "$policy" --config "$config" --set start_guard_s=0.5 --quiet > "$work/second.log" 2>&1
+  timeout -s INT 5 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --set start_guard_s=0.5 --quiet > "$work/second.log" 2>&1
   rc=$?
   [ $rc -eq 3 ] || fail "the second runner exited with $rc, expected 3 (refused)"
   grep -q "REFUSED: another runner" "$work/second.log" || fail "the second runner did not say why"
@@ -205,8 +217,8 @@ crouch)
   # The runner outlives the simulated robot (4 s after its first command): a robot whose runner
   # stopped damps itself after its command timeout, which would let the crouch sag.
   for attempt in 1 2; do
-    "$sim" "$policy" --seed 0 --duration 4 --quiet --tilt-state-after 1.0 --tilt-rad 1.0 > "$work/sim.log" 2>&1 & pids+=($!)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 4.8 --quiet > "$work/deploy.log" 2>&1
+    "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 4 --quiet --tilt-state-after 1.0 --tilt-rad 1.0 > "$work/sim.log" 2>&1 & pids+=($!)
+    timeout -s INT 20 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --duration 4.8 --quiet > "$work/deploy.log" 2>&1
     rc=$?
     wait "${pids[-1]}"
     [ $rc -eq 0 ] || fail "masa_deploy exited with $rc"
@@ -231,7 +243,7 @@ crouch)
 refusals)
   for entry in trifinger_lift:cube ant_acrobatic:ball_root humanoid_dribbling:ball; do
     task=${entry%%:*} joint=${entry#*:}
-    "$deploy" "$src/tasks/$task/policy/policy.bin" --config "$src/configs/deploy/$task.yaml" --quiet > "$work/$task.log" 2>&1
+    "$deploy" "$src/tasks/$task/policy/policy.bin" "${runner_keys[@]}" --config "$src/configs/deploy/$task.yaml" --quiet > "$work/$task.log" 2>&1
     rc=$?
     [ $rc -eq 2 ] || fail "$task: masa_deploy exited with $rc, expected 2 (refused)"
     grep -q "task $task cannot run on a robot's state alone: joint '$joint' is neither driven" "$work/$task.log" ||
@@ -241,17 +253,13 @@ refusals)
   echo "PASS: TriFinger Lift, Ant Acrobatic and Humanoid Dribbling are refused, naming what the robot cannot measure"
   ;;
 signed_commands)
-  roster_bin="$build/tools/masa_roster"
   forger="$build/tests/masa_test_robot_message_forger"
-  for b in "$roster_bin" "$forger"; do [ -x "$b" ] || fail "$b is missing: build first"; done
-  "$roster_bin" make "$work/keys" --actors 1 --runner > "$work/roster.log" 2>&1 || fail "masa_roster make failed"
-  roster="$work/keys/roster"
-  signing=(--roster "$roster" --signing-key "$work/keys/keys/runner0.key")
-  # 1. A verifying robot, the signed runner, and the forger with the actor's key.
-  "$sim" "$policy" --seed 0 --duration 4.5 --quiet --roster "$roster" > "$work/sim.log" 2>&1 & pids+=($!)
+  [ -x "$forger" ] || fail "$forger is missing: build first"
+  # 1. The robot and the runner as they start by default (signed), and the forger with the actor's key.
+  "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 4.5 --quiet > "$work/sim.log" 2>&1 & pids+=($!)
   "$forger" --roster "$roster" --signing-key "$work/keys/keys/actor0.key" --actor 0 --duration 8 \
     > "$work/forger.log" 2>&1 & pids+=($!)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" "${signing[@]}" --max-policy-steps 100 --quiet \
+  timeout -s INT 20 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --max-policy-steps 100 --quiet \
     > "$work/deploy.log" 2>&1 || fail "the signing runner exited with $?"
   wait "${pids[0]}" || fail "the verifying robot exited with $?"
   wait "${pids[1]}" || fail "the forger exited with $?"
@@ -267,34 +275,25 @@ signed_commands)
     [[ $refused =~ MASA_ROBOT_COMMAND:\ [^\;]*$reason\ [1-9] ]] || fail "no $reason command refused: $refused"
   done
   echo "verifying robot: $refused; $(grep -o 'forger: .*' "$work/forger.log")"
-  # 2. A robot that does not verify takes the signed commands (the trailer is not part of them).
-  "$sim" "$policy" --seed 0 --duration 2.5 --quiet > "$work/sim2.log" 2>&1 & pids+=($!)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" "${signing[@]}" --max-policy-steps 20 --quiet \
-    > "$work/deploy2.log" 2>&1 || fail "the signing runner exited with $? beside a robot that does not verify"
-  wait "${pids[2]}"
-  grep -q "policy phase" "$work/sim2.log" || fail "a robot that does not verify took none of the signed commands"
-  # 3. An unsigned runner and a verifying robot: every command refused, the robot never starts.
-  "$sim" "$policy" --seed 0 --duration 2 --quiet --roster "$roster" > "$work/sim3.log" 2>&1 & pids+=($!)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" --duration 2 --quiet > "$work/deploy3.log" 2>&1
-  kill -INT "${pids[3]}"; wait "${pids[3]}"
+  # 2. An --insecure runner (unsigned commands; it reads the signed state unverified) and the robot
+  # as it starts by default: every command refused, the robot never starts.
+  "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 2 --quiet > "$work/sim3.log" 2>&1 & pids+=($!)
+  timeout -s INT 20 "$deploy" "$policy" --insecure --config "$config" --duration 2 --quiet > "$work/deploy3.log" 2>&1
+  kill -INT "${pids[2]}"; wait "${pids[2]}"
   grep -q "commands from 0 runner(s)" "$work/sim3.log" || fail "the verifying robot took an unsigned command"
   grep -qE "MASA_ROBOT_COMMAND: [^;]*unauthenticated [1-9]" "$work/sim3.log" || fail "the unsigned commands were not counted as unauthenticated"
   echo "PASS: the robot took the runner's signed commands only; forged, replayed and unsigned ones were refused"
   ;;
 signed_state)
-  roster_bin="$build/tools/masa_roster"
   forger="$build/tests/masa_test_robot_message_forger"
-  for b in "$roster_bin" "$forger"; do [ -x "$b" ] || fail "$b is missing: build first"; done
-  "$roster_bin" make "$work/keys" --actors 1 --runner --robot > "$work/roster.log" 2>&1 || fail "masa_roster make failed"
-  roster="$work/keys/roster"
-  robot=(--roster "$roster" --signing-key "$work/keys/keys/robot0.key")
-  runner=(--roster "$roster" --signing-key "$work/keys/keys/runner0.key")
+  [ -x "$forger" ] || fail "$forger is missing: build first"
   forge=(--state --roster "$roster" --signing-key "$work/keys/keys/actor0.key" --actor 0)
-  # 1. A signing robot, a runner that verifies the state, and the forger: the runner walks the robot.
+  # 1. The robot and the runner as they start by default (the robot signs its state, the runner
+  # verifies it) and the forger: the runner walks the robot.
   for attempt in 1 2; do
-    "$sim" "$policy" --seed 0 --duration 4.5 --quiet "${robot[@]}" > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 4.5 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
     "$forger" "${forge[@]}" --duration 8 > "$work/forger.log" 2>&1 & forger_pid=$!; pids+=($forger_pid)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" "${runner[@]}" --verify-state --max-policy-steps 100 \
+    timeout -s INT 20 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --max-policy-steps 100 \
       --exit-on-trip --quiet > "$work/deploy.log" 2>&1
     rc=$?
     wait "$sim_pid"; kill -INT "$forger_pid" 2>/dev/null; wait "$forger_pid"
@@ -313,11 +312,11 @@ signed_state)
     [[ $refused =~ MASA_ROBOT_STATE:\ [^\;]*$reason\ [1-9] ]] || fail "no $reason state refused: $refused"
   done
   echo "verifying runner: $refused; $(grep -o 'forger: .*' "$work/forger.log")"
-  # 2. The same forger beside a runner that does not verify: a forged state reaches it and it leaves
-  # its policy (what the verification prevents, shown happening).
-  "$sim" "$policy" --seed 0 --duration 4.5 --quiet "${robot[@]}" > "$work/sim2.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+  # 2. The same forger beside an --insecure runner (state unverified): a forged state reaches it and
+  # it leaves its policy (what the verification prevents, shown happening).
+  "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 4.5 --quiet > "$work/sim2.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
   "$forger" "${forge[@]}" --duration 8 > "$work/forger2.log" 2>&1 & forger_pid=$!; pids+=($forger_pid)
-  timeout -s INT 20 "$deploy" "$policy" --config "$config" "${runner[@]}" --max-policy-steps 100 --exit-on-trip --quiet \
+  timeout -s INT 20 "$deploy" "$policy" --insecure --config "$config" --max-policy-steps 100 --exit-on-trip --quiet \
     > "$work/deploy2.log" 2>&1
   rc=$?
   kill -INT "$sim_pid" "$forger_pid" 2>/dev/null; wait "$sim_pid"; wait "$forger_pid"
@@ -325,15 +324,41 @@ signed_state)
   echo "runner that does not verify: $(grep -m1 -oE '(damping|hold|emergency stop): .*' "$work/deploy2.log")"
   echo "PASS: the verifying runner took the robot's signed state only; replayed, actor-signed and unsigned state were refused"
   ;;
+future_command)
+  forger="$build/tests/masa_test_robot_message_forger"
+  [ -x "$forger" ] || fail "$forger is missing: build first"
+  for attempt in 1 2; do
+    "$sim" "$policy" --insecure --seed 0 --duration 4.5 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$forger" --future --duration 8 > "$work/forger.log" 2>&1 & forger_pid=$!; pids+=($forger_pid)
+    timeout -s INT 20 "$deploy" "$policy" --insecure --config "$config" --max-policy-steps 100 --exit-on-trip --quiet \
+      > "$work/deploy.log" 2>&1
+    rc=$?
+    wait "$sim_pid"; kill -INT "$forger_pid" 2>/dev/null; wait "$forger_pid"
+    [ "$rc" -eq 0 ] && break
+    grep -qE "estop [1-9][0-9]* physics steps" "$work/sim.log" &&
+      fail "the robot applied a forged far-future command: $(grep 'command modes' "$work/sim.log")"
+    retry_after_stale_trip "$attempt" "beside the command forger" || fail "masa_deploy exited with $rc"
+  done
+  grep -qE "robot command forger: [1-9][0-9]* unsigned commands 10 s in the future" "$work/forger.log" ||
+    fail "the forger sent nothing: $(cat "$work/forger.log")"
+  modes=$(grep "command modes" "$work/sim.log") || fail "no command modes from the simulated robot"
+  grep -q "estop 0 physics steps" <<< "$modes" || fail "the robot applied a forged far-future command: $modes"
+  refused=$(grep "commands refused after decoding" "$work/sim.log") || fail "the robot did not count commands refused by its clock"
+  [[ $refused =~ ahead_of_clock\ [1-9] ]] || fail "no command refused as ahead_of_clock: $refused"
+  grep -q "policy phase" "$work/sim.log" || fail "the robot took none of the runner's policy commands"
+  grep -q "fell: no" "$work/sim.log" || fail "the robot fell"
+  echo "$refused; $(grep -o 'forger: .*' "$work/forger.log")"
+  echo "PASS: forged commands stamped 10 s ahead were refused by the robot's clock and did not move it"
+  ;;
 foreign_runner)
   # One unsigned command with another runner_id, as anyone on the robot's LAN can send, 2 s into the
-  # policy: the runner stops (exit 3), and the last command it put on the wire is the safe one.
+  # policy of an --insecure runner: the runner stops (exit 3), and the last command it put on the wire is the safe one.
   foreign="$build/tests/masa_test_foreign_runner"
   [ -x "$foreign" ] || fail "$foreign is missing: build first"
   for attempt in 1 2; do
-    "$sim" "$policy" --seed 0 --duration 6 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$sim" "$policy" --insecure --seed 0 --duration 6 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
     "$foreign" --after 100 --id 77 > "$work/foreign.log" 2>&1 & foreign_pid=$!; pids+=($foreign_pid)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" --quiet > "$work/deploy.log" 2>&1
+    timeout -s INT 20 "$deploy" "$policy" --insecure --config "$config" --quiet > "$work/deploy.log" 2>&1
     rc=$?
     wait "$foreign_pid"; kill -INT "$sim_pid" 2>/dev/null; wait "$sim_pid"
     retry_after_stale_trip $attempt "before the foreign command" || break
@@ -353,17 +378,14 @@ foreign_runner_signed)
   # goes on; a command signed with the roster's runner key (a second runner holding it, started
   # after this one) stops it (exit 3) with the safe command.
   foreign="$build/tests/masa_test_foreign_runner"
-  roster_bin="$build/tools/masa_roster"
-  for b in "$roster_bin" "$foreign"; do [ -x "$b" ] || fail "$b is missing: build first"; done
-  "$roster_bin" make "$work/keys" --actors 1 --runner > "$work/roster.log" 2>&1 || fail "masa_roster make failed"
-  roster="$work/keys/roster"
+  [ -x "$foreign" ] || fail "$foreign is missing: build first"
   for attempt in 1 2; do
-    "$sim" "$policy" --seed 0 --duration 8 --quiet --roster "$roster" > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 8 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
     "$foreign" --after 60 --id 77 > "$work/unsigned.log" 2>&1 & f1=$!; pids+=($f1)
     "$foreign" --after 70 --id 78 --roster "$roster" --signing-key "$work/keys/keys/actor0.key" --as actor \
       > "$work/actor.log" 2>&1 & f2=$!; pids+=($f2)
-    timeout -s INT 20 "$deploy" "$policy" --config "$config" --roster "$roster" \
-      --signing-key "$work/keys/keys/runner0.key" --quiet > "$work/deploy.log" 2>&1 & deploy_pid=$!; pids+=($deploy_pid)
+    timeout -s INT 20 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --quiet > "$work/deploy.log" 2>&1 &
+    deploy_pid=$!; pids+=($deploy_pid)
     # Started after the runner, its counters are above the runner's: new to the runner's window.
     sleep 1
     "$foreign" --after 150 --id 79 --roster "$roster" --signing-key "$work/keys/keys/runner0.key" --as runner \
@@ -398,13 +420,13 @@ safe_stop)
   [ -x "$foreign" ] || fail "$foreign is missing: build first"
   for how in duration TERM HUP INT; do
     for attempt in 1 2; do
-      "$sim" "$policy" --seed 0 --duration 4 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+      "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 4 --quiet > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
       "$foreign" --after -1 --duration 10 > "$work/witness.log" 2>&1 & witness_pid=$!; pids+=($witness_pid)
       if [ $how = duration ]; then
-        timeout -s KILL 20 "$deploy" "$policy" --config "$config" --duration 2.5 --quiet > "$work/deploy.log" 2>&1
+        timeout -s KILL 20 "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --duration 2.5 --quiet > "$work/deploy.log" 2>&1
         rc=$?
       else
-        "$deploy" "$policy" --config "$config" --quiet > "$work/deploy.log" 2>&1 & deploy_pid=$!; pids+=($deploy_pid)
+        "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --quiet > "$work/deploy.log" 2>&1 & deploy_pid=$!; pids+=($deploy_pid)
         sleep 2.5
         kill -$how "$deploy_pid"
         wait "$deploy_pid"; rc=$?
@@ -425,8 +447,8 @@ command_timeout)
   for timeout_ms in 150 100; do
     set_timeout=()
     [ $timeout_ms = 150 ] || set_timeout=(--command-timeout-ms $timeout_ms)
-    "$sim" "$policy" --seed 0 --duration 4 --quiet "${set_timeout[@]}" > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
-    "$deploy" "$policy" --config "$config" --quiet > "$work/deploy.log" 2>&1 & deploy_pid=$!; pids+=($deploy_pid)
+    "$sim" "$policy" "${robot_keys[@]}" --seed 0 --duration 4 --quiet "${set_timeout[@]}" > "$work/sim.log" 2>&1 & sim_pid=$!; pids+=($sim_pid)
+    "$deploy" "$policy" "${runner_keys[@]}" --config "$config" --quiet > "$work/deploy.log" 2>&1 & deploy_pid=$!; pids+=($deploy_pid)
     sleep 2.5
     kill -KILL "$deploy_pid"; wait "$deploy_pid" 2>/dev/null
     wait "$sim_pid" || fail "masa_sim_robot exited with $?"
@@ -442,5 +464,5 @@ command_timeout)
   done
   echo "PASS: the robot damped itself within its command timeout once the runner was killed"
   ;;
-*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands|signed_state|foreign_runner|foreign_runner_signed|safe_stop|command_timeout PORT"; exit 2 ;;
+*) echo "usage: $0 walk|walk_tuned|faults|stale|nan|second_runner|humanoid|crouch|refusals|signed_commands|signed_state|foreign_runner|foreign_runner_signed|safe_stop|command_timeout|future_command PORT"; exit 2 ;;
 esac

@@ -15,7 +15,8 @@ work=$(mktemp -d /tmp/masa_file_integrity.XXXXXX)
 trap 'rm -rf "$work"' EXIT
 policy=tasks/a1_beam/policy/policy.bin
 size=$(stat -c %s "$policy")
-robot=(--config configs/deploy/a1_beam_sim.yaml --url memq:// --duration 0.3 --quiet --set start_guard_s=0.05)
+# No robot on memq://: the policy file is under test, not the robot channels (--insecure: unsigned).
+robot=(--config configs/deploy/a1_beam_sim.yaml --url memq:// --duration 0.3 --quiet --set start_guard_s=0.05 --insecure)
 
 flip() {  # flip FILE BYTE: one bit of that byte
   python3 -c "import sys; p, i = sys.argv[1], int(sys.argv[2]); b = bytearray(open(p, 'rb').read()); b[i] ^= 1 << (i % 8); open(p, 'wb').write(b)" "$1" "$2"

@@ -9,7 +9,8 @@
 #  2. The forging actor re-signs the learner's parameters with its actor key (version + 1000,
 #     parameters zeroed): both actors refuse every one (MASA_POLICY: not_permitted), and its unsigned
 #     copies (unauthenticated); no actor acted with a forged version (the learner dropped no chunk as
-#     future_version). Its heartbeats in actor 0's name are refused by rank 0 (claims_another_sender).
+#     future_version). Its heartbeats in actor 0's name are refused by rank 0 (claims_another_sender),
+#     and actor 1's chunks it copies from rank 1's rollout URL to rank 0's (another_ranks_actor).
 #  3. No process of the job has a key on its command line (ps, during the job).
 #  4. deploy/train.sh --ranks 2 signs by default (mpirun_train.sh --auth signed); --auth hmac gives
 #     the job the run key RUN_DIR/run.key.
@@ -80,6 +81,10 @@ grep "rank 0 of 2: rollout chunks accepted" "$work/job.log" | grep -q future_ver
   fail "an actor acted with forged parameters (the learner dropped chunks of a future version)"
 grep -E "rank 0 of 2: other messages rejected before decoding: .*on the parameters. URL .*MASA_ACTOR_HEARTBEAT: [^;]*claims_another_sender [1-9]" "$work/job.log" ||
   fail "rank 0 did not refuse the heartbeats in actor 0's name"
+grep -E "forging actor 2: .*, [1-9][0-9]* of actor 1's chunks copied to rank 0" "$work/job.log" ||
+  fail "the forging actor copied none of actor 1's chunks to rank 0"
+grep -E "rank 0 of 2: rollout chunks accepted .*another_ranks_actor [1-9]" "$work/job.log" ||
+  fail "rank 0 did not refuse actor 1's chunks copied to its rollout URL: $(grep 'rank 0 of 2: rollout chunks accepted' "$work/job.log")"
 
 log "3. no key on a command line"
 [ "$(wc -l < "$work/ps.txt")" -ge 4 ] || fail "ps saw $(wc -l < "$work/ps.txt") processes of the job"

@@ -50,7 +50,7 @@ WireVerdict verdictOf(MessageSigner& signer, const Roster& roster, const std::st
   const int size = static_cast<int>(wire.size());
   wire.resize(wire.size() + kSigTrailerBytes);
   signer.seal(channel, wire.data(), size, wire.data() + size);
-  MessageVerifier verifier(std::make_shared<Roster>(roster));
+  MessageVerifier verifier(std::make_shared<Roster>(roster), 0);
   return verifier.open(channel, wire.data(), static_cast<int>(wire.size())).verdict;
 }
 

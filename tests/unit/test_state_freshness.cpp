@@ -89,5 +89,30 @@ TEST(StateFreshness, RefusedStatesThatDoNotFormAConsistentStreamNeverResync) {
   EXPECT_EQ(f.resyncs(), 0);
 }
 
+// Issue #55, item 2: a forger on an unsigned state channel sends, after every real state, one state
+// a little less than the lead ahead of the newest state taken. Each alone is within the lead; if a
+// taken state moved the lead, they would walk it forward without end and every real state would be
+// a repeat from then on. The lead stays where the baseline put it: the forgeries beyond it are
+// refused as ahead, and the robot's own states are news again within one lead.
+TEST(StateFreshness, ForgedStatesInterleavedWithTheRealOnesCannotWalkTheLeadForward) {
+  StateFreshness f(kLead);
+  Robot r;
+  for (int k = 0; k < 20; ++k, r.t += kPeriod) ASSERT_EQ(f.judge(r.utime(), r.t), V::kNew);
+  int64_t forged = r.utime() - kPeriod;  // the newest taken
+  int real_new = 0, forged_taken = 0, last_real_refused = -1;
+  constexpr int kSteps = 200;  // one second
+  for (int k = 0; k < kSteps; ++k, r.t += kPeriod) {
+    if (f.judge(r.utime(), r.t) == V::kNew) ++real_new; else last_real_refused = k;
+    forged += kLead * 9 / 10;
+    const V v = f.judge(forged, r.t + kPeriod / 2);
+    if (v == V::kNew || v == V::kResynced) ++forged_taken;
+  }
+  EXPECT_LE(forged_taken, 1) << "only a forgery inside the baseline's lead may be taken";
+  EXPECT_LT(last_real_refused, kLead / kPeriod + 1) << "real states refused after the first lead: the lead walked forward";
+  EXPECT_GE(real_new, kSteps - kLead / kPeriod - 1);
+  EXPECT_GE(f.refusedAhead(), kSteps - 2);
+  EXPECT_EQ(f.resyncs(), 0);
+}
+
 }  // namespace
 }  // namespace masa::deploy
