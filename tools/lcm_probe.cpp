@@ -231,7 +231,7 @@ void ProbeRecorder::printSummary() {
 std::unique_ptr<transport::Transport> openBus(const ProbeArgs& a, const std::optional<transport::RunKey>& key) {
   if (a.roster_file.empty()) return std::make_unique<transport::Transport>(a.url, key);
   return std::make_unique<transport::Transport>(
-      a.url, transport::SignedMode{nullptr, std::make_shared<const transport::Roster>(transport::Roster::load(a.roster_file))});
+      a.url, transport::SignedMode{nullptr, std::make_shared<const transport::Roster>(transport::Roster::load(a.roster_file)), {}});
 }
 
 // Receives until a signal, --count or --duration; false on an LCM error.

@@ -65,7 +65,7 @@ struct SignedRun {
                                            {Role::kActor, static_cast<uint32_t>(a)}, *roster));
   }
   ~SignedRun() { fs::remove_all(dir); }
-  SignedMode as(const std::shared_ptr<MessageSigner>& who) const { return {who, roster}; }
+  SignedMode as(const std::shared_ptr<MessageSigner>& who) const { return {who, roster, {}}; }
 };
 
 // `message` with the SIG1 trailer of `signer` for `channel` (its next counter).
@@ -246,7 +246,7 @@ TEST(MessageSignTransport, ASignedMessageReachesEverySubscriptionOnceWithItsOrig
 // cannot publish, neither signed nor unsigned.
 TEST(MessageSignTransport, AWatcherWithTheRosterVerifiesEveryMessageAndCannotPublish) {
   SignedRun run(1, "watcher");
-  Transport bus("memq://", SignedMode{nullptr, run.roster});
+  Transport bus("memq://", SignedMode{nullptr, run.roster, {}});
   EXPECT_TRUE(bus.authenticates());
   EXPECT_FALSE(bus.signs());
   int taken = 0;
@@ -262,7 +262,7 @@ TEST(MessageSignTransport, AWatcherWithTheRosterVerifiesEveryMessageAndCannotPub
   EXPECT_EQ(count(bus, kPolicyChannel, WireVerdict::kUnauthenticated), 1);
   EXPECT_THROW(bus.publishRaw(kPolicyChannel, message.data(), static_cast<int>(message.size())), std::logic_error);
   EXPECT_THROW(bus.publish(kPolicyChannel, samplePolicy()), std::logic_error);
-  EXPECT_THROW(Transport("memq://", SignedMode{run.learner, nullptr}), std::invalid_argument);
+  EXPECT_THROW(Transport("memq://", SignedMode{run.learner, nullptr, {}}), std::invalid_argument);
 }
 
 TEST(MessageSignTransport, AReplayedValidMessageIsRefusedAndCountedAndOneFromBeyondTheWindowToo) {

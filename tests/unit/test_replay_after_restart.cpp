@@ -58,7 +58,7 @@ std::vector<uint8_t> signedCommand(MessageSigner& signer, int64_t utime) {
 struct VerifyingRobot {
   Transport bus;
   int taken = 0;
-  explicit VerifyingRobot(std::shared_ptr<const Roster> roster) : bus("memq://", SignedMode{nullptr, std::move(roster)}) {
+  explicit VerifyingRobot(std::shared_ptr<const Roster> roster) : bus("memq://", SignedMode{nullptr, std::move(roster), {}}) {
     bus.subscribeRaw(kRobotCommandChannel, [this](const void*, int) { ++taken; });
   }
   void send(const std::vector<uint8_t>& b) {
