@@ -42,11 +42,17 @@ BatchedEnv::BatchedEnv(const config::RunConfig& config, const sym::SymmetrySpec&
 }
 
 void BatchedEnv::reset(uint64_t seed, float* obs) {
+  std::lock_guard<std::mutex> lock(busy_);
   for (int e = 0; e < numEnvs(); ++e) rngs_[e].seed(seed + static_cast<uint64_t>(e));
-  resetContinuing(obs);
+  resetEnvironments(obs);
 }
 
 void BatchedEnv::resetContinuing(float* obs) {
+  std::lock_guard<std::mutex> lock(busy_);
+  resetEnvironments(obs);
+}
+
+void BatchedEnv::resetEnvironments(float* obs) {
   const int d = obsDim();
   forEachEnv(numEnvs(), threads_, [&](int e) {
     envs_[e]->reset(rngs_[e]);
@@ -55,6 +61,7 @@ void BatchedEnv::resetContinuing(float* obs) {
 }
 
 void BatchedEnv::step(const float* actions, const StepBuffers& out) {
+  std::lock_guard<std::mutex> lock(busy_);
   const int d = obsDim(), a = actDim();
   forEachEnv(numEnvs(), threads_, [&](int e) {
     task::Task& env = *envs_[e];

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,7 @@ class BatchedEnv {
   const std::vector<std::string>& rewardTermNames() const { return envs_[0]->rewardTermNames(); }
   const task::Task& env(int e) const { return *envs_.at(static_cast<size_t>(e)); }
 
+  // reset and step take a lock: Python threads may call them at once with the GIL released.
   // Environment e restarts from Rng(seed + e); obs: num_envs x obs_dim.
   void reset(uint64_t seed, float* obs);
   // Every environment restarts from its own generator as it stands (no new seeds).
@@ -54,11 +56,14 @@ class BatchedEnv {
   void step(const float* actions, const StepBuffers& out);
 
  private:
+  void resetEnvironments(float* obs);  // each from its generator as it stands; the lock held
+
   sym::SymmetrySpec spec_;
   std::unique_ptr<task::TaskFactory> factory_;
   std::vector<std::unique_ptr<task::Task>> envs_;
   std::vector<Rng> rngs_;
   int threads_;
+  std::mutex busy_;
 };
 
 }  // namespace masa::python
