@@ -74,6 +74,11 @@ student, loss = train(*augment(obs, act), iterations)
 plain, plain_loss = train(obs.astype(np.float32), act, iterations)
 print(f"trained on {len(obs)} teacher steps x {sym.order} symmetry images, final loss {loss:.4f}")
 probe = collect(20, seed=100)[0]
+returns = {}
 for name, fn in (("teacher", teacher.act), ("student (augmented)", student), ("student (plain)", plain)):
-    print(f"{name:22s} return over {steps} steps: {mean_return(fn, steps, seed=1000):9.2f}   "
+    returns[name] = mean_return(fn, steps, seed=1000)
+    print(f"{name:22s} return over {steps} steps: {returns[name]:9.2f}   "
           f"equivariance error: {masa.check_equivariance(fn, sym, probe):.2e}")
+learned = returns["student (augmented)"] > 0.5 * returns["teacher"]
+print("the student walks: its return is over half the teacher's" if learned else "the student did NOT learn: its return is under half the teacher's")
+sys.exit(0 if learned else 1)
