@@ -66,6 +66,9 @@ class VectorEnv:
         self.single_action_space = Box(-1.0, 1.0, (self._env.act_dim,), np.float32)
         self.observation_space = batch(self.single_observation_space, num_envs)
         self.action_space = batch(self.single_action_space, num_envs)
+        for space in (self.single_action_space, self.action_space):  # sample() draws from make_env's seed
+            if hasattr(space, "seed"):
+                space.seed(seed)
         self.closed = False
         self._renderer = None
 
@@ -148,8 +151,8 @@ class VectorEnv:
 
 def make_env(task, num_envs=1, seed=0, overrides=None, config_file="", num_threads=None, render_mode=None):
     """A batched environment of a catalog task (masa.task_names()), a run directory's task
-    (config_file: its config.yaml or the directory), or a masa.Policy's own task (task=policy:
-    the env section it was trained with).
+    (task=None, config_file: its config.yaml or the directory), a masa.RunConfig, or a
+    masa.Policy's own task (task=policy: the env section it was trained with).
 
     overrides: config keys as masa_train's --set takes them, {"env.max_episode_steps": 200}.
     num_threads: threads stepping the environments (default: the cores, at most num_envs).

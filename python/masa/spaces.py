@@ -1,5 +1,6 @@
 """Observation and action spaces: Gymnasium's Box when Gymnasium is installed, else a small Box
-with the same attributes (shape, dtype, low, high, sample, contains)."""
+with the same attributes (shape, dtype, low, high, sample, contains). sample() draws from the
+space's own generator, seeded (0 unless seed() says otherwise: the same seed, the same samples)."""
 import numpy as np
 
 try:
@@ -9,7 +10,7 @@ except ImportError:
     class Box:
         """A box of float arrays, low <= x <= high element-wise (Gymnasium's Box, in small)."""
 
-        def __init__(self, low, high, shape=None, dtype=np.float32, seed=None):
+        def __init__(self, low, high, shape=None, dtype=np.float32, seed=0):
             self.dtype = np.dtype(dtype)
             shape = tuple(shape) if shape is not None else np.shape(low)
             self.shape = shape
@@ -17,7 +18,7 @@ except ImportError:
             self.high = np.broadcast_to(np.asarray(high, dtype=self.dtype), shape).copy()
             self.np_random = np.random.default_rng(seed)
 
-        def seed(self, seed=None):
+        def seed(self, seed=0):
             self.np_random = np.random.default_rng(seed)
             return [seed]
 
