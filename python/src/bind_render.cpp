@@ -28,7 +28,8 @@ void bindRender(py::module_& m) {
                                     render::robotViewDistance(first.model(), first.data()), 135.0, -20.0);
              return r;
            }),
-           py::arg("env"), py::arg("width"), py::arg("height"))
+           py::arg("env"), py::arg("width"), py::arg("height"),
+           py::keep_alive<1, 2>())  // the environment (its model) lives as long as its renderer
       .def_property_readonly("size", [](const Renderer& r) {
         return py::make_tuple(r.renderer->width(), r.renderer->height());
       })
