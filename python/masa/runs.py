@@ -1,5 +1,5 @@
-"""Runs from Python: start one with masa_train (the tools' own launcher, one call), and read a run
-directory back: its resolved config, its metrics as arrays, its policy."""
+"""Runs from Python: start one with the tools' own launchers (masa_train, or deploy/train.sh), one
+call, and read a run directory back: its resolved config, its metrics as arrays, its policy."""
 import os
 import shutil
 import subprocess
@@ -67,25 +67,50 @@ class Run:
         return f"masa.Run({self.path!r})"
 
 
-def train(task, run_dir, updates=None, overrides=None, recipe=None, threads=None, quiet=True, check=True):
-    """Trains with masa_train (a learner and an actor in one process, as the README's run does)
-    and returns the Run. overrides: config keys as --set takes them. Errors: masa_train's message
-    in a RuntimeError (check=False returns the Run whatever happened)."""
+def _build_dir():
+    """The build tree this module belongs to (tools/, learner/, actors/ beside python/), or None
+    for an installed module."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    build = os.path.normpath(os.path.join(here, "..", ".."))
+    return build if os.path.isfile(os.path.join(build, "CMakeCache.txt")) else None
+
+
+def train(task, run_dir, updates=None, overrides=None, recipe=None, threads=None, quiet=True, check=True,
+          launcher="masa_train", actors=2, envs=None):
+    """Starts a training run and returns it when it ends (masa.Run). launcher: "masa_train" (a
+    learner and an actor in one process) or "train.sh" (deploy/train.sh, the README's run: one
+    masa_learner and `actors` masa_actor processes of `envs` environments each over loopback LCM,
+    from this module's build tree). overrides: config keys as --set takes them. Errors: the
+    launcher's message in a RuntimeError (check=False returns the Run whatever happened)."""
     from .env import _override_strings
-    cmd = [_tool("masa_train"), "--run-dir", os.fspath(run_dir), "--set", f"task={task}"]
+    run_dir = os.path.abspath(os.fspath(run_dir))
+    sets = []
     for s in _override_strings(overrides):
-        cmd += ["--set", s]
+        sets += ["--set", s]
+    if launcher == "masa_train":
+        cmd = [_tool("masa_train"), "--run-dir", run_dir, "--set", f"task={task}"] + sets
+        if threads is not None:
+            cmd += ["--threads", str(int(threads))]
+        if quiet:
+            cmd.append("--quiet")
+        cwd, env = None, None
+    elif launcher == "train.sh":
+        build = _build_dir()
+        if build is None:
+            raise FileNotFoundError("train.sh runs from a build tree; this module is installed (use launcher='masa_train')")
+        cmd = ["bash", "deploy/train.sh", task, "--run-dir", run_dir, "--actors", str(int(actors))] + sets
+        if envs is not None:
+            cmd += ["--envs", str(int(envs))]
+        cwd, env = _masa.source_dir(), dict(os.environ, MASA_BUILD_DIR=build)
+    else:
+        raise ValueError(f"launcher must be 'masa_train' or 'train.sh', got {launcher!r}")
     if recipe:
         cmd += ["--recipe", recipe]
     if updates is not None:
         cmd += ["--updates", str(int(updates))]
-    if threads is not None:
-        cmd += ["--threads", str(int(threads))]
-    if quiet:
-        cmd.append("--quiet")
-    done = subprocess.run(cmd, capture_output=True, text=True)
+    done = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd, env=env)
     if check and done.returncode != 0:
-        raise RuntimeError(done.stderr.strip() or f"masa_train exited with {done.returncode}")
+        raise RuntimeError(done.stderr.strip() or f"{launcher} exited with {done.returncode}")
     return Run(run_dir)
 
 

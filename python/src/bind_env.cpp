@@ -28,6 +28,8 @@ void bindEnv(py::module_& m) {
       },
       py::arg("overrides"), py::arg("base_file") = "");
   m.def("configs_dir", [] { return config::defaultConfigsDir(); });
+  // The source tree the module was built from: the tasks' models, deploy/train.sh.
+  m.def("source_dir", [] { return std::string(MASA_SOURCE_DIR); });
 
   py::class_<BatchedEnv>(m, "BatchedEnv")
       .def(py::init([](const config::RunConfig& c, int num_envs, int threads) {

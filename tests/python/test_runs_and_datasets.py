@@ -1,4 +1,5 @@
-"""Runs and datasets from Python: masa.train starts a run with masa_train, masa.Run reads its
+"""Runs and datasets from Python: masa.train starts a run with masa_train (and with deploy/train.sh:
+a learner and two actor processes over loopback LCM), masa.Run reads its
 config (as the tools resolve it) and its metrics as arrays equal to metrics.csv read by Python's
 csv module, and evaluates its policy; masa.read_dataset reads masa_dataset's LCM log and its HDF5
 export, both equal to the export read by h5py, the episodes' returns those of masa_eval's episodes
@@ -37,6 +38,11 @@ def check_run(work, failures):
     evaluated = r.evaluate(episodes=2, max_steps=20)
     if evaluated["return"].shape != (2,) or not np.all(evaluated["length"] == 20):
         failures.append(f"evaluating the run gave {evaluated['return']}, lengths {evaluated['length']}")
+    launched = masa.train("a1_beam", os.path.join(work, "launched"), updates=2, overrides=TINY, launcher="train.sh",
+                          actors=2, envs=4)
+    actor_logs = sorted(f for f in os.listdir(launched.path) if f.startswith("actor"))
+    if list(launched.metrics["env_steps"]) != [64, 128] or actor_logs != ["actor0.log", "actor1.log"]:
+        failures.append(f"train.sh's run: env_steps {launched.metrics['env_steps']}, actor logs {actor_logs}")
     try:
         masa.train("a1_beam", os.path.join(work, "bad"), updates=1, overrides={"ppo.horizn": 8})
         failures.append("train() with a wrong key did not raise")
