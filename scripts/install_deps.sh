@@ -37,6 +37,9 @@ packages=(
   libonnx-dev libprotobuf-dev python3-onnx
   # TensorBoard event files, read back in the tests by an independent decoder (Python's protobuf)
   python3-protobuf
+  # the Python module (python/, `import masa`): pybind11 and NumPy; PyYAML reads run configs and,
+  # in the tests, the symmetry specs apart from masa's own parser
+  pybind11-dev python3-dev python3-numpy python3-yaml
 )
 
 # --bench: also the packages that only the comparison benchmarks need (never CI, never a training
