@@ -235,10 +235,15 @@ double Actor::awaitLimitSeconds() const {
 
 void Actor::awaitNewerParams() {
   const double began = nowSeconds();
-  const double deadline = began + awaitLimitSeconds();
   // With ppo.max_policy_lag 0 the parameters that answer the rollout just sent; with lag L those
   // that answer the rollout L before it (PolicyLagWindow), so rollouts and updates overlap.
   const int64_t needed = lag_window_.neededVersion();
+  // The learner evaluates its policy after publishing every runner.eval_every-th version, before it
+  // makes the next: those parameters come late by the evaluation, and a wait of the usual length
+  // would send a rollout too old to use. Waits for them are as long as the bound allows.
+  const int64_t eval_every = config_.runner.eval_every;
+  const bool after_evaluation = eval_every > 0 && needed > 1 && (needed - 1) % eval_every == 0;
+  const double deadline = began + std::max(awaitLimitSeconds(), after_evaluation ? options_.await_params_max_s : 0.0);
   for (double now = nowSeconds(); std::max(pending_version_, version_) < needed && now < deadline && !stopRequested();
        now = nowSeconds()) {
     // Short slices: the stop flag and heartbeats are served while waiting.

@@ -73,7 +73,9 @@ struct ActorOptions {
   double await_params_s = 1.0;
   // Then 1.5x the learner's recent answer time (from the end of a rollout to the next parameters),
   // between these bounds (AwaitBudget): a big batch's update outlasts await_params_s, and a fast
-  // learner short of a lost chunk's environments should not stand still for it.
+  // learner short of a lost chunk's environments should not stand still for it. The parameters that
+  // follow the learner's evaluation (every runner.eval_every updates) come late by it: waited for
+  // this long.
   double await_params_max_s = 10.0;
   double await_params_min_s = 0.02;
   // An actor whose learner is gone (no parameters, not even the learner's periodic repeat) stops

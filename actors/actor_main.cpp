@@ -128,7 +128,8 @@ int main(int argc, char** argv) {
                  "once (0: never wait; keeps data on-policy)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--await-params-max-s", opt.await_params_max_s,
-                 "then the wait is 1.5x the learner's answer time, up to this long")
+                 "then the wait is 1.5x the learner's answer time, up to this long (the parameters that follow "
+                 "the learner's evaluation, every runner.eval_every updates: this long)")
       ->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--await-params-min-s", opt.await_params_min_s, "... and at least this long")
       ->capture_default_str()->check(CLI::NonNegativeNumber);

@@ -30,7 +30,9 @@
 #   MASA_REMOTE_DIR        this repository's path on the hosts (default: the same as here)
 #   MASA_REMOTE_BUILD_DIR  the build folder there, relative to MASA_REMOTE_DIR (default MASA_BUILD_DIR)
 # Defaults are sized for a 2-core machine (the paper's 4096 x 32 batches are GPU-scale):
-# 2 actors x 32 environments, horizon 32, minibatch 1024. Override anything with --set.
+# 2 actors x 32 environments, horizon 32, minibatch 1024. Override anything with --set. The config's
+# horizon is kept and its minibatch sized for the environments asked for (deploy/batch_size.sh,
+# said at the start); a ppo.minibatch_size that cannot divide the batch is refused before anything starts.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -38,7 +40,7 @@ task=a1_beam method=masa task_given=0 method_given=0
 [ $# -gt 0 ] && [[ $1 != --* ]] && { task=$1; task_given=1; shift; }
 [ $# -gt 0 ] && [[ $1 != --* ]] && { method=$1; method_given=1; shift; }
 actors=2 envs=32 envs_given=0 updates="" hosts_file="" actors_given=0 resume="" recipe="" run_dir_given="" auth_mode=signed ranks=1
-sets=()
+sets=() user_sets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --resume) resume=$2; shift 2 ;;
@@ -48,7 +50,7 @@ while [ $# -gt 0 ]; do
     --run-dir) run_dir_given=$2; shift 2 ;;
     --updates) updates=$2; shift 2 ;;
     --hosts) hosts_file=$2; shift 2 ;;
-    --set) sets+=(--set "$2"); shift 2 ;;
+    --set) sets+=(--set "$2"); user_sets+=("$2"); shift 2 ;;
     --no-auth) auth_mode=none; shift ;;
     --auth) auth_mode=$2; shift 2 ;;
     --ranks) ranks=$2; shift 2 ;;
@@ -91,6 +93,16 @@ if [ -n "$recipe" ]; then
   fi
 fi
 updates=${updates:-200}
+source deploy/batch_size.sh
+# The run's config before its environments (deploy/batch_size.sh sizes the minibatch from it). Without a
+# recipe: sized for a 2-core machine, 2 actors x 32 environments x horizon 32 in minibatches of 1024
+# (the paper's batches, 4096 envs x 32 steps, minibatch 32768, are GPU-scale).
+if [ -n "$recipe" ]; then
+  run_config=(--set "@$recipe" --set task="$task" --set method="$method" "${sets[@]+"${sets[@]}"}")
+else
+  run_config=(--set task="$task" --set method="$method" --set ppo.num_envs=64 --set ppo.horizon=32
+              --set ppo.minibatch_size=1024 "${sets[@]+"${sets[@]}"}")
+fi
 # A resumed run's environments: its config's, over the actors, unless --envs says otherwise.
 if [ -n "$resume" ] && [ "$envs_given" = 0 ] && [ -z "$hosts_file" ] && [ -r "$resume/config.yaml" ]; then
   run_envs=$(sed -n 's/^  num_envs: //p' "$resume/config.yaml")
@@ -117,12 +129,11 @@ if [ "$ranks" -gt 1 ]; then
   else
     run_dir=${run_dir_given:-"${MASA_RUNS_DIR:-runs}/${task}_${method}_$(date +%Y%m%d_%H%M%S)"}
     job+=(--run-dir "$run_dir")
-    if [ -n "$recipe" ]; then
-      job+=(--set "@$recipe" --set "task=$task" --set "method=$method" --set "ppo.num_envs=$((actors * envs))")
-    else
-      job+=(--set ppo.horizon=32 --set ppo.minibatch_size=1024)  # sized for a small machine, as below
-    fi
-    job+=("${sets[@]+"${sets[@]}"}")
+    size_batch train.sh $((actors * envs)) "${run_config[@]}" || exit 2
+    # The sized minibatch goes as a setting of the job's (mpirun_train.sh checks that it divides).
+    [ -n "$recipe" ] && job+=(--set "@$recipe") || job+=(--set ppo.horizon=32)
+    job+=("${sets[@]+"${sets[@]}"}" "${batch_sets[@]+"${batch_sets[@]}"}")
+    echo "train.sh: $batch_summary"
   fi
   echo "train.sh: $task / $method, $ranks learner ranks, $actors actors x $envs envs, $updates updates, one MPI job"
   exec bash deploy/cluster/mpirun_train.sh "${job[@]}"
@@ -181,20 +192,16 @@ if [ -n "$resume" ]; then
   common=("${sets[@]+"${sets[@]}"}")
   task=$(sed -n 's/^task: //p' "$run_dir/config.yaml") method=$(sed -n 's/^method: //p' "$run_dir/config.yaml")
 else
+  # Sized before anything is made: a refused request leaves nothing behind.
+  size_batch train.sh "$total_envs" "${run_config[@]}" || exit 2
+  echo "train.sh: $batch_summary"
   run_id=$(( ($(date +%s%N) / 1000) % 2000000000 + 1 ))
   run_dir=${run_dir_given:-"${MASA_RUNS_DIR:-runs}/${task}_${method}_$(date +%Y%m%d_%H%M%S)"}
   mkdir -p "$run_dir"
   echo "$run_id" > "$run_dir/run_id"
   learner_run=(--run-dir "$run_dir")
   actor_config=()
-  if [ -n "$recipe" ]; then
-    common=(--set "@$recipe" --set task="$task" --set method="$method" --set "ppo.num_envs=$total_envs"
-            "${sets[@]+"${sets[@]}"}")
-  else
-    # Sized for a 2-core machine; the paper's batches (4096 envs x 32 steps, minibatch 32768) are GPU-scale.
-    common=(--set task="$task" --set method="$method" --set "ppo.num_envs=$total_envs"
-            --set ppo.horizon=32 --set ppo.minibatch_size=1024 "${sets[@]+"${sets[@]}"}")
-  fi
+  common=("${run_config[@]}" --set "ppo.num_envs=$total_envs" "${batch_sets[@]+"${batch_sets[@]}"}")
 fi
 
 # The keys, before anything starts: the learner and every actor read theirs at start-up. Only

@@ -148,7 +148,12 @@ void Learner::evaluate() {
   o.deterministic = true;
   o.threads = omp_get_max_threads();
   task::PolicyEvaluator evaluator(*eval_factory_, algorithm_->evaluationModel());
-  const task::EvalSummary s = evaluator.run(o);
+  // The actors' chunks are taken in meanwhile, not left to overflow the socket's receive buffer.
+  int steps = 0;
+  const auto take_chunks = [this, &steps](int, int, const task::Task&, bool) {
+    if (++steps % 64 == 0) transport_->drain();
+  };
+  const task::EvalSummary s = evaluator.run(o, take_chunks);
   report_.eval_return = s.ret.mean;
   report_.eval_length = s.length.mean;
   report_.eval_success = s.success_rate >= 0 ? s.success_rate : std::nan("");
@@ -361,7 +366,6 @@ void Learner::update() {
   report_.dropped_envs = static_cast<int64_t>(drops[1]);
   report_.eval_return = report_.eval_length = report_.eval_success = std::nan("");
   report_.eval_progress.assign(columns_.progress_names.size(), std::nan(""));
-  if (eval_factory_ && updates_ % rc_.runner.eval_every == 0) evaluate();
 
   assembler_->setLearnerVersion(updates_);
   collector_->setLearnerVersion(updates_);
@@ -369,6 +373,9 @@ void Learner::update() {
   if (ranks_->size() > 1 && updates_ % opt_.rank_check_every == 0) checkRanksAgree();
   if (!isLeadRank()) return;  // rank 0 speaks for the ranks and keeps the run directory
   publishParams();
+  // After the parameters went out, so that the actors collect while the policy is evaluated
+  // (evaluated before, the actors waited past their limit and sent rollouts too old to use).
+  if (eval_factory_ && updates_ % rc_.runner.eval_every == 0) evaluate();
   report();
   if (round_events_) {
     appendRoundRow(lag_mean, lag_max);

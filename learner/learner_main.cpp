@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "common/core/build_info.hpp"
+#include "common/config/batch_shape.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
 #include "common/cluster/job_plan.hpp"
@@ -171,6 +172,7 @@ int main(int argc, char** argv) {
     // A resumed run reads its own config.yaml: the run goes on with the settings it started with.
     const std::string base = resume_dir.empty() ? "" : resume_dir + "/config.yaml";
     const auto rc = masa::config::loadRunConfig(configs, overrides, base);
+    masa::config::checkBatchShape(rc, ranks ? ranks->size() : 1);
     masa::learner::LearnerOptions opt;
     opt.url = url;
     opt.run_id = run_id;

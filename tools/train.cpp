@@ -22,6 +22,7 @@
 #include "actors/actor.hpp"
 #include "actors/environments_snapshot.hpp"
 #include "common/core/build_info.hpp"
+#include "common/config/batch_shape.hpp"
 #include "common/config/run_config.hpp"
 #include "common/model/method.hpp"
 #include "common/transport/local_bus.hpp"
@@ -73,6 +74,7 @@ int main(int argc, char** argv) {
       run_dir = resume;
     }
     const auto rc = masa::config::loadRunConfig(configs, overrides, resume.empty() ? "" : resume + "/config.yaml");
+    masa::config::checkBatchShape(rc, 1);
     if (updates == 0) updates = rc.ppo.max_updates;
     if (run_dir.empty())
       run_dir = masa::learner::defaultRunDir(rc.task + "_" + masa::model::methodName(rc.method) + "_inprocess", rc.seed);

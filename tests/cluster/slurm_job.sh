@@ -5,7 +5,7 @@
 #  1. trains 20 updates and ends: every rank's rows in metrics.csv, every process gone;
 #  2. cancelled with scancel mid-run: every process of the job stops within seconds, and the
 #     learners leave a checkpoint of the update they reached.
-#   tests/cluster/slurm_job.sh BUILD_DIR     (exit 77: skipped)
+#   tests/cluster/slurm_job.sh BUILD_DIR     (exit 77: skipped, where root, Slurm or munge is missing)
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 build=$(cd "${1:-build}" && pwd)
@@ -22,7 +22,11 @@ fail() {
   exit 1
 }
 log() { echo "[$(date +%H:%M:%S)] $*"; }
-local_slurm_start "$work/slurm" || exit 77
+# Missing root, Slurm or munge: skipped (77); present but the cluster does not come up: failed.
+slurm_status=0
+local_slurm_start "$work/slurm" || slurm_status=$?
+[ "$slurm_status" -ne 1 ] || exit 77
+[ "$slurm_status" -eq 0 ] || exit 1
 cd "$repo"
 marker=$((100000 + RANDOM * 7 % 800000))  # the seed marks this test's processes (pgrep)
 small=(--set ppo.horizon=16 --set ppo.minibatch_size=128 --set model.policy_hidden=[16] --set model.critic_hidden=[16]

@@ -1,7 +1,10 @@
 // Data-parallel PPO over MPI, run as `mpirun -np 2 masa_test_ppo_ranks` (tests/CMakeLists.txt):
 //  1. Two learner ranks, each with its share of the environments, against one learner with all of
-//     them (rank 0 runs both): parameters, both normalizers and the learning rate agree within
-//     kTolerance after several updates; MASA and SASA, equal shares and a short rank (lost chunks).
+//     them (rank 0 runs both), with the learner's own settings (Adam's eps 1e-8), after each of
+//     kUpdates updates: both normalizers, the learning rate and the KL agree within kTolerance, the
+//     parameters within kTolerance (SA, SASA) or kMasaParamsTolerance (MASA); the ranks among
+//     themselves bit for bit (the learner's hash check relies on it). MASA and SASA, equal shares
+//     and a short rank (lost chunks).
 //  2. Ranks whose parameters differ (one weight of rank 1 nudged) are caught by the parameter hash
 //     check on every rank, which names rank 1; identical ranks pass it.
 // Exit status 0 and "PASS" on rank 0 when every check holds.
@@ -20,8 +23,16 @@
 namespace masa {
 namespace {
 
-// Relative to max(1, |reference|): the ranks' sums add the same terms in another order.
+// Relative to max(1, |reference|): the ranks' sums add the same terms in another order, so they
+// round differently. Adam (eps 1e-8) divides each step by the gradient's running magnitude: a
+// weight whose gradient vanishes (in MASA the mirror cancels some exactly) steps by up to the
+// learning rate in the direction of that rounding, in one learner as in N ranks. Measured with these
+// settings: MASA's parameters 7e-4 after one update, 1.1e-3 after three; SA 1.4e-6, SASA 2e-7; the
+// normalizers, learning rate and KL below 1e-7. A real fault (a share weighted wrongly, a statistic
+// not reduced) is of the order of the training's own steps (kMoved and more).
 constexpr double kTolerance = 1e-5;
+constexpr double kMasaParamsTolerance = 2e-3;
+constexpr double kMoved = 2e-2;  // the least the parameters move in one update here
 constexpr int kHorizon = 4, kUpdates = 3;
 
 int failures = 0;
@@ -54,15 +65,7 @@ struct Learner {
     model = std::make_unique<model::ActorCritic<float>>(spec, mc);
     Rng init(11);
     model->initialize(init);
-    // Adam's eps well above the gradients' rounding noise (1e-9 here). With the default 1e-8, a
-    // weight whose true gradient is ~0 steps by up to the learning rate in the direction of its
-    // rounding noise, in one learner as in N ranks, and the two runs part chaotically (MASA: 1e-2
-    // after 3 updates, where the mirror makes some gradients vanish; SA, SASA: 1e-7). With 1e-4
-    // the step is Lipschitz in the gradient (lr / eps), so the sums' rounding stays near rounding
-    // and any real difference (a share weighted wrongly, a statistic not reduced) stays O(1).
-    nn::AdamConfig<float> adam_config;
-    adam_config.eps = 1e-4f;
-    adam = std::make_unique<nn::Adam<float>>(model->params(), adam_config);
+    adam = std::make_unique<nn::Adam<float>>(model->params(), nn::AdamConfig<float>{});  // the learner's defaults
     trainer = std::make_unique<ppo::PpoTrainer>(*model, *adam, ppoConfig(num_envs), ranks);
     buffer = std::make_unique<ppo::RolloutBuffer>(num_envs, kHorizon, spec.obsDim(), spec.actDim());
   }
@@ -142,32 +145,44 @@ void ranksTrainAsOneLearner(cluster::Communicator& ranks, model::Method method, 
   Learner part(method, shares[ranks.rank()], ranks);
   Rng data(99), shuffle_whole(7), shuffle_part(7);
   ppo::PpoStats ref_stats, part_stats;
-  for (int u = 0; u < kUpdates; ++u) {
+  auto vec = [](const Vec<float>& v) { return Eigen::VectorXd(v.cast<double>()); };
+  const Eigen::VectorXd initial = vec(whole.model->params().values());
+  for (int u = 1; u <= kUpdates; ++u) {
     fillBatch(whole, data);
     copyEnvs(*whole.buffer, first, *part.buffer);
     part_stats = part.trainer->update(*part.buffer, shuffle_part);
     ref_stats = whole.trainer->update(*whole.buffer, shuffle_whole);  // every rank: it also feeds the batches
+    const double params = relativeGap(vec(part.model->params().values()), vec(whole.model->params().values()));
+    const double obs_mean = relativeGap(part.model->obsNormalizer().mean(), whole.model->obsNormalizer().mean());
+    const double obs_var = relativeGap(part.model->obsNormalizer().var(), whole.model->obsNormalizer().var());
+    const double value_norm = relativeGap(part.model->valueNormalizer().var(), whole.model->valueNormalizer().var()) +
+                              relativeGap(part.model->valueNormalizer().mean(), whole.model->valueNormalizer().mean());
+    const double lr = std::abs(part_stats.lr - ref_stats.lr) / ref_stats.lr;
+    const double kl = std::abs(part_stats.kl - ref_stats.kl) / std::max(1e-12, ref_stats.kl);
+    const double moved = relativeGap(vec(whole.model->params().values()), initial);
+    if (ranks.rank() == 0)
+      std::printf("%-34s gaps after %d update(s): params %.2e, obs mean %.2e, var %.2e, value norm %.2e, lr %.2e, "
+                  "kl %.2e (params moved %.2e; lr %.3g)\n",
+                  name.c_str(), u, params, obs_mean, obs_var, value_norm, lr, kl, moved, ref_stats.lr);
+    const std::string after = " after " + std::to_string(u) + " update(s)";
+    expect(moved > kMoved, name + ": training moved the parameters" + after);
+    expect(params <= (method == model::Method::kMasa ? kMasaParamsTolerance : kTolerance), name + ": parameters" + after);
+    expect(obs_mean <= kTolerance && obs_var <= kTolerance, name + ": observation normalizer" + after);
+    expect(value_norm <= kTolerance, name + ": value normalizer" + after);
+    expect(lr <= kTolerance, name + ": learning rate" + after);
+    expect(kl <= kTolerance, name + ": KL" + after);
+    expect(part_stats.minibatches == ref_stats.minibatches, name + ": minibatch count" + after);
   }
-  auto vec = [](const Vec<float>& v) { return Eigen::VectorXd(v.cast<double>()); };
-  const double params = relativeGap(vec(part.model->params().values()), vec(whole.model->params().values()));
-  const double obs_mean = relativeGap(part.model->obsNormalizer().mean(), whole.model->obsNormalizer().mean());
-  const double obs_var = relativeGap(part.model->obsNormalizer().var(), whole.model->obsNormalizer().var());
-  const double value_norm = relativeGap(part.model->valueNormalizer().var(), whole.model->valueNormalizer().var()) +
-                            relativeGap(part.model->valueNormalizer().mean(), whole.model->valueNormalizer().mean());
-  const double lr = std::abs(part_stats.lr - ref_stats.lr) / ref_stats.lr;
-  const double kl = std::abs(part_stats.kl - ref_stats.kl) / std::max(1e-12, ref_stats.kl);
-  const double moved = relativeGap(vec(whole.model->params().values()), vec(Learner(method, total, cluster::soloCommunicator()).model->params().values()));
-  if (ranks.rank() == 0)
-    std::printf("%-34s gaps after %d updates: params %.2e, obs mean %.2e, var %.2e, value norm %.2e, lr %.2e, kl %.2e "
-                "(params moved %.2e; lr %.3g)\n",
-                name.c_str(), kUpdates, params, obs_mean, obs_var, value_norm, lr, kl, moved, ref_stats.lr);
-  expect(moved > 100 * kTolerance, name + ": training moved the parameters");
-  expect(params <= kTolerance, name + ": parameters");
-  expect(obs_mean <= kTolerance && obs_var <= kTolerance, name + ": observation normalizer");
-  expect(value_norm <= kTolerance, name + ": value normalizer");
-  expect(lr <= kTolerance, name + ": learning rate");
-  expect(kl <= 1e-3, name + ": KL");
-  expect(part_stats.minibatches == ref_stats.minibatches, name + ": minibatch count");
+  // The ranks among themselves: bit for bit, or the learner's hash check would stop the run.
+  const auto& p = part.model->params().values();
+  std::string disagreement;
+  try {
+    cluster::requireSameOnEveryRank(ranks, cluster::hashBytes(p.data(), sizeof(float) * static_cast<std::size_t>(p.size())),
+                                    "parameters");
+  } catch (const cluster::RankDisagreement& e) {
+    disagreement = e.what();
+  }
+  expect(disagreement.empty(), name + ": the ranks' parameters are not bit for bit the same: " + disagreement);
 }
 
 void hashCheckNamesThePerturbedRank(cluster::Communicator& ranks) {
