@@ -7,11 +7,12 @@
 # MASA_BUILD_DIR; tests/mpi/device_bundle.sh trains with 2 ranks from it with the system's
 # copies hidden.
 #   bench/device_bundle.sh [--build BUILD] [--out DIR] [--programs "PATH ..."]   (default: build, .device,
-#                          the four programs of scaling_device.sh, paths inside BUILD)
+#                          the programs of scaling_device.sh and masa_config, which the launchers
+#                          size the batch with; paths inside BUILD)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build out=.device
-programs=(learner/masa_learner actors/masa_actor bench/bench_learner_ranks bench/bench_efficiency_bound)
+programs=(learner/masa_learner actors/masa_actor tools/masa_config bench/bench_learner_ranks bench/bench_efficiency_bound)
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build=$2; shift 2 ;;

@@ -13,7 +13,7 @@ cd "$repo"
   { echo "SKIP: needs root and unshare -m (a mount namespace to hide the system's libraries)"; exit 77; }
 work=$(mktemp -d /tmp/masa_device_bundle.XXXXXX)
 trap 'rm -rf "$work"' EXIT
-bash bench/device_bundle.sh --build "$build" --out "$work/bundle" --programs "learner/masa_learner actors/masa_actor" ||
+bash bench/device_bundle.sh --build "$build" --out "$work/bundle" --programs "learner/masa_learner actors/masa_actor tools/masa_config" ||
   { echo "FAIL: device_bundle.sh"; exit 1; }
 # Inside the namespace: the system's copies hidden, then only the bundle's environment. The tools
 # the scripts use (grep, sed, mkdir) link libraries the bundle also carries, so they run after
