@@ -68,6 +68,7 @@ class PhysicsRandomization {
   // The episode's latency: whole control steps, and the fraction of a step beyond them.
   int latencySteps() const { return latency_steps_; }
   double latencyFraction() const { return latency_ - latency_steps_; }
+  bool perturbsObservations() const { return config_.obs_noise_std > 0.0 || config_.obs_bias > 0.0; }
   // Adds the episode's bias and a step's noise (from noise_rng) to an observation.
   void perturbObservation(float* obs, int n, Rng& noise_rng) const;
   // The orbit of each element kind (symmetric mode's draw groups), exposed for tests.

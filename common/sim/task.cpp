@@ -132,7 +132,7 @@ void Task::reset(Rng& rng) {
 
 void Task::observe(float* out) const {
   writeObservation(out);
-  if (randomization_) {
+  if (randomization_ && randomization_->perturbsObservations()) {
     // The step's noise, a function of the episode's seed and the step: the same state observes
     // the same, also in a copy or a resumed actor.
     Rng noise(static_cast<uint64_t>(noise_seed_) ^ (0x9E3779B97F4A7C15ULL * static_cast<uint64_t>(episode_.length + 1)));
@@ -197,8 +197,8 @@ void Task::advancePhysics(const float* action) {
   if (randomization_ && (randomization_->latencySteps() > 0 || randomization_->latencyFraction() > 0.0)) {
     // The latency: the action of latencySteps() steps ago drives this step, and the one before
     // it the first substeps of the fraction.
-    commanded_.erase(commanded_.begin());
-    commanded_.push_back(action_scratch_);
+    std::rotate(commanded_.begin(), commanded_.begin() + 1, commanded_.end());  // no allocation per step
+    std::copy(action_scratch_.begin(), action_scratch_.end(), commanded_.back().begin());
     // commanded_ holds latencySteps() + 2 actions, newest last (zeros before the episode's first).
     const int late = static_cast<int>(std::lround(randomization_->latencyFraction() * frame_skip_));
     const std::vector<double>& delayed = commanded_[1];
