@@ -54,11 +54,11 @@ Actor::Actor(const config::RunConfig& config, ActorOptions options, transport::M
     : config_(config),
       options_(std::move(options)),
       num_envs_(options_.num_envs),
-      horizon_(config.ppo.horizon),
+      horizon_(config.rollout.horizon),
       transport_(transport),
       chunker_(options_.chunk_bytes) {
   if (num_envs_ <= 0) throw std::runtime_error("actor: num_envs must be positive, got " + std::to_string(num_envs_));
-  if (horizon_ <= 0) throw std::runtime_error("actor: ppo.horizon must be positive, got " + std::to_string(horizon_));
+  if (horizon_ <= 0) throw std::runtime_error("actor: " + config.rollout.key("horizon") + " must be positive, got " + std::to_string(horizon_));
   if (options_.actor_id < 0) throw std::runtime_error("actor: actor_id must be >= 0");
   if (options_.threads <= 0) throw std::runtime_error("actor: threads must be positive");
   if (!(options_.drop_chunks_percent >= 0.0 && options_.drop_chunks_percent <= 100.0))
@@ -235,7 +235,7 @@ double Actor::awaitLimitSeconds() const {
 
 void Actor::awaitNewerParams() {
   const double began = nowSeconds();
-  // With ppo.max_policy_lag 0 the parameters that answer the rollout just sent; with lag L those
+  // With max_policy_lag 0 the parameters that answer the rollout just sent; with lag L those
   // that answer the rollout L before it (PolicyLagWindow), so rollouts and updates overlap.
   const int64_t needed = lag_window_.neededVersion();
   // The learner evaluates its policy after publishing every runner.eval_every-th version, before it

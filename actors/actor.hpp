@@ -192,7 +192,7 @@ class Actor {
   int pending_count_ = 0;
   bool pending_has_norm_ = false;
   // The rollouts sent and not yet answered, and what the next needs (config_ is declared above).
-  PolicyLagWindow lag_window_{config_.ppo.max_policy_lag};
+  PolicyLagWindow lag_window_{config_.rollout.max_policy_lag};
   double last_learner_s_ = 0;   // when the learner was last heard (new parameters or its repeat)
   // The wait for newer parameters, adapted to the learner's answer time (options_ is declared above).
   AwaitBudget await_budget_{options_.await_params_s, options_.await_params_max_s, options_.await_params_min_s};

@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
       }
     } join{watcher, acting};
     std::fprintf(stderr, "masa_actor %d: task %s, %d envs, horizon %d, run %lld; %s\n", opt.actor_id,
-                 rc.task.c_str(), opt.num_envs, rc.ppo.horizon, static_cast<long long>(opt.run_id),
+                 rc.task.c_str(), opt.num_envs, rc.rollout.horizon, static_cast<long long>(opt.run_id),
                  opt.start_without_learner ? "starting with own parameters" : "waiting for parameters");
     if (opt.drop_chunks_percent > 0)
       std::fprintf(stderr, "masa_actor %d: FAULT INJECTION: throwing away %g%% of rollout chunks (seed %llu)\n",

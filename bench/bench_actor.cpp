@@ -293,9 +293,9 @@ void actorLoop(benchmark::State& state, const std::string& name) {
     actor.collectAndPublish();
     episodes += actor.lastRollout().numEpisodes();
   }
-  const int64_t steps = state.iterations() * kEnvs * rc.ppo.horizon;
+  const int64_t steps = state.iterations() * kEnvs * rc.rollout.horizon;
   setCounters(state, r, steps);
-  state.counters["horizon"] = rc.ppo.horizon;
+  state.counters["horizon"] = rc.rollout.horizon;
   state.counters["resets_per_1k"] = 1000.0 * static_cast<double>(episodes) / static_cast<double>(steps);
 }
 

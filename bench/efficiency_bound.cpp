@@ -23,6 +23,7 @@
 #include "common/transport/channels.hpp"
 #include "common/config/run_config.hpp"
 #include "learner/learner.hpp"
+#include "learner/ppo_algorithm.hpp"
 
 namespace {
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
     const auto rc = masa::config::loadRunConfig(masa::config::defaultConfigsDir(), overrides);
     const std::string dir = (std::filesystem::temp_directory_path() / ("masa_bound_" + std::to_string(getpid()))).string();
     masa::learner::LearnerOptions lo;
+    lo.make_algorithm = masa::learner::makePpoAlgorithm;
     lo.url = "memq://";
     lo.run_dir = dir;
     lo.run_id = 1;
@@ -57,7 +59,7 @@ int main(int argc, char** argv) {
     omp_set_num_threads(1);
     masa::learner::Learner learner(rc, lo);
     masa::actor::ActorOptions ao;
-    ao.num_envs = rc.ppo.num_envs;
+    ao.num_envs = rc.rollout.num_envs;
     ao.run_id = 1;
     ao.threads = 1;
     ao.incarnation = 1;  // bit-identical chunks from run to run
@@ -67,7 +69,7 @@ int main(int argc, char** argv) {
     double rollout_bytes = 0, params_bytes = 0;
     learner.transport().subscribeRaw(masa::transport::kRolloutChannel, [&](const void*, int n) { rollout_bytes += n; });
     learner.transport().subscribeRaw(masa::transport::kPolicyChannel, [&](const void*, int n) { params_bytes = n; });
-    const double steps = static_cast<double>(rc.ppo.num_envs) * rc.ppo.horizon;
+    const double steps = static_cast<double>(rc.rollout.num_envs) * rc.rollout.horizon;
     std::vector<double> t_env, t_learn;
     for (int r = 0; r <= rounds; ++r) {
       if (!actor.pollParams(0)) {
@@ -89,7 +91,7 @@ int main(int argc, char** argv) {
     std::filesystem::remove_all(dir);
     const double e = median(t_env), l = median(t_learn);
     std::printf("config: %s / %s, %d envs x %d steps, minibatch %d x %d mini-epochs\n", rc.task.c_str(),
-                masa::model::methodName(rc.method).c_str(), rc.ppo.num_envs, rc.ppo.horizon, rc.ppo.minibatch_size,
+                masa::model::methodName(rc.method).c_str(), rc.rollout.num_envs, rc.rollout.horizon, rc.ppo.minibatch_size,
                 rc.ppo.mini_epochs);
     std::printf("t_env   %.2f us per env step (one core: physics, inference, sampling, chunking)\n", e * 1e6);
     std::printf("t_learn %.2f us per env step (learner core-seconds: intake, GAE, all mini-epochs)\n", l * 1e6);

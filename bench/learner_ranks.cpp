@@ -108,12 +108,12 @@ int main(int argc, char** argv) {
   masa::nn::AdamConfig<float> ac;
   ac.lr = static_cast<float>(rc.ppo.learning_rate);
   masa::nn::Adam<float> adam(model.params(), ac);
-  if (rc.ppo.num_envs % ranks.size() != 0) {
-    std::fprintf(stderr, "ppo.num_envs %d does not divide among %d ranks\n", rc.ppo.num_envs, ranks.size());
+  if (rc.rollout.num_envs % ranks.size() != 0) {
+    std::fprintf(stderr, "num_envs %d does not divide among %d ranks\n", rc.rollout.num_envs, ranks.size());
     return 2;
   }
   masa::ppo::PpoTrainer trainer(model, adam, rc.ppo, timed);
-  masa::ppo::RolloutBuffer buffer(rc.ppo.num_envs / ranks.size(), rc.ppo.horizon, model.obsDim(), model.actDim());
+  masa::ppo::RolloutBuffer buffer(rc.rollout.num_envs / ranks.size(), rc.rollout.horizon, model.obsDim(), model.actDim());
   masa::Rng data(1000 + ranks.rank()), shuffle(rc.seed);
 
   double prepare_s = 0, optimize_s = 0, wall_s = 0;

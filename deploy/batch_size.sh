@@ -1,5 +1,6 @@
-# Sizes the PPO batch for the environments a launch asks for (sourced by deploy/train.sh and the
-# cluster launchers). A task file or recipe sizes its minibatches for its own ppo.num_envs (the
+# Sizes the batch for the environments a launch asks for (sourced by deploy/train.sh and the
+# cluster launchers): the environments go to the learner's own key (ppo.num_envs, or sac.num_envs
+# for the off-policy learner). A task file or recipe sizes its minibatches for its own ppo.num_envs (the
 # task files: 4096 environments x 32 steps in minibatches of 32768); for other environments that
 # minibatch need not divide the batch, and the learner would refuse the run. So a launcher keeps
 # the config's horizon and its number of minibatches per mini-epoch, and takes the minibatch size
@@ -7,23 +8,26 @@
 # checked instead: a request that cannot be met is refused here, before anything starts, saying
 # which option to change.
 #   size_batch PROG TOTAL_ENVS [--set key=value ...]   (the run's config options, users' included,
-#                                                      but not the launch's own ppo.num_envs)
+#                                                      but not the launch's own environments)
 # Reads $build (the build folder) and user_sets (the user's own --set options). Sets batch_sets
-# (the --set options to add after the config's) and batch_summary (what was chosen, one line).
+# (the --set options to add after the config's, the environments included) and batch_summary
+# (what was chosen, one line).
 # Returns 2 after printing why, to standard error.
 size_batch() {
   local prog=$1 envs=$2
   shift 2
-  local resolved
+  local resolved shape section
   resolved=$("$build/tools/masa_config" "$@") || { echo "$prog: the configuration above is refused" >&2; return 2; }
-  batch_sets=()
-  if grep -q '^learner: off_policy$' <<< "$resolved"; then
-    batch_summary="$envs environments, off-policy (no PPO minibatches to size)"
+  shape=$("$build/tools/masa_config" --rollout "$@") || return 2
+  section=$(shape_key section <<< "$shape")
+  batch_sets=(--set "$section.num_envs=$envs")
+  if [ "$section" = sac ]; then
+    batch_summary="$envs environments x horizon $(shape_key horizon <<< "$shape"), off-policy (no PPO minibatches to size)"
     return 0
   fi
   local config_envs horizon config_minibatch
-  config_envs=$(ppo_key num_envs <<< "$resolved")
-  horizon=$(ppo_key horizon <<< "$resolved")
+  config_envs=$(shape_key num_envs <<< "$shape")
+  horizon=$(shape_key horizon <<< "$shape")
   config_minibatch=$(ppo_key minibatch_size <<< "$resolved")
   local batch=$((envs * horizon)) shape="$envs environments x horizon $horizon"
 
@@ -50,10 +54,16 @@ size_batch() {
     if ((wanted - d >= 1 && batch % (wanted - d) == 0)); then count=$((wanted - d)); break; fi
   done
   local minibatch=$((batch / count))
-  batch_sets=(--set "ppo.minibatch_size=$minibatch")
+  batch_sets+=(--set "ppo.minibatch_size=$minibatch")
   batch_summary="$shape = $batch samples per update, $count minibatches of $minibatch"
   [ "$minibatch" = "$config_minibatch" ] ||
     batch_summary+=" (the config's $config_minibatch is for $config_envs environments; --set ppo.minibatch_size=N to choose)"
+}
+
+# The value of KEY in `masa_config --rollout`'s output on standard input (section, num_envs,
+# horizon, max_updates, max_policy_lag: the numbers of the learner's own section).
+shape_key() {
+  sed -n "s/^$1: //p"
 }
 
 # The value of KEY in the ppo section of a resolved config on standard input.

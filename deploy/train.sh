@@ -82,8 +82,9 @@ if [ -n "$recipe" ]; then
   resolved=$("$build/tools/masa_config" --set "@$recipe" "${sets[@]+"${sets[@]}"}") || exit 2
   [ "$task_given" = 1 ] || task=$(sed -n 's/^task: //p' <<< "$resolved")
   [ "$method_given" = 1 ] || method=$(sed -n 's/^method: //p' <<< "$resolved")
-  recipe_envs=$(sed -n 's/^  num_envs: //p' <<< "$resolved")
-  [ -n "$updates" ] || updates=$(sed -n 's/^  max_updates: //p' <<< "$resolved")
+  shape=$("$build/tools/masa_config" --rollout --set "@$recipe" "${sets[@]+"${sets[@]}"}") || exit 2
+  recipe_envs=$(sed -n 's/^num_envs: //p' <<< "$shape")
+  [ -n "$updates" ] || updates=$(sed -n 's/^max_updates: //p' <<< "$shape")
   if [ "$envs_given" = 0 ] && [ -z "$hosts_file" ]; then
     if (( recipe_envs % actors != 0 )); then
       echo "train.sh: recipe $recipe has $recipe_envs environments, not divisible over $actors actors (give --envs)" >&2
@@ -100,12 +101,17 @@ source deploy/batch_size.sh
 if [ -n "$recipe" ]; then
   run_config=(--set "@$recipe" --set task="$task" --set method="$method" "${sets[@]+"${sets[@]}"}")
 else
-  run_config=(--set task="$task" --set method="$method" --set ppo.num_envs=64 --set ppo.horizon=32
-              --set ppo.minibatch_size=1024 "${sets[@]+"${sets[@]}"}")
+  run_config=(--set task="$task" --set method="$method")
+  shape=$("$build/tools/masa_config" --rollout "${run_config[@]}" "${sets[@]+"${sets[@]}"}") || exit 2
+  # PPO's minibatches as for 64 environments (the off-policy learner has its own small default).
+  if grep -qx 'section: ppo' <<< "$shape"; then
+    run_config+=(--set ppo.num_envs=64 --set ppo.horizon=32 --set ppo.minibatch_size=1024)
+  fi
+  run_config+=("${sets[@]+"${sets[@]}"}")
 fi
 # A resumed run's environments: its config's, over the actors, unless --envs says otherwise.
 if [ -n "$resume" ] && [ "$envs_given" = 0 ] && [ -z "$hosts_file" ] && [ -r "$resume/config.yaml" ]; then
-  run_envs=$(sed -n 's/^  num_envs: //p' "$resume/config.yaml")
+  run_envs=$("$build/tools/masa_config" --run-config "$resume/config.yaml" --rollout | sed -n 's/^num_envs: //p')
   if [[ $run_envs =~ ^[0-9]+$ ]] && (( run_envs % actors == 0 )); then envs=$((run_envs / actors)); fi
 fi
 
@@ -201,7 +207,7 @@ else
   echo "$run_id" > "$run_dir/run_id"
   learner_run=(--run-dir "$run_dir")
   actor_config=()
-  common=("${run_config[@]}" --set "ppo.num_envs=$total_envs" "${batch_sets[@]+"${batch_sets[@]}"}")
+  common=("${run_config[@]}" "${batch_sets[@]+"${batch_sets[@]}"}")
 fi
 
 # The keys, before anything starts: the learner and every actor read theirs at start-up. Only

@@ -92,7 +92,7 @@ if [ -n "$extend" ]; then
     echo "grid.sh: --extend changes only the updates of the grid in --out: give it no other grid options" >&2; exit 2
   fi
   have=$(sed -n 's/^updates=//p' "$out/grid.txt")
-  [ -n "$have" ] || { echo "grid.sh: $out's runs follow each recipe's ppo.max_updates (no --updates); --extend needs a number to go on from" >&2; exit 2; }
+  [ -n "$have" ] || { echo "grid.sh: $out's runs follow each recipe's length (ppo.max_updates, or sac.env_steps off-policy; no --updates); --extend needs a number to go on from" >&2; exit 2; }
   [ "$extend" -gt "$have" ] || { echo "grid.sh: $out's runs already go to $have updates; --extend $extend must be more" >&2; exit 2; }
   # A finished run goes on only from its checkpoint; without one (a record made without them) it
   # would start afresh and lose its updates, so the extension is refused before anything changes.
@@ -180,9 +180,11 @@ if [ "$status" = 1 ]; then
        "$( [ "$running" = 1 ] && echo "running, $slots_now at a time" || echo "not running")"
   for t in $tasks; do for m in $methods; do for sd in $seeds; do
     dir="$out/$t/${m}_s$sd" target=$updates
-    # max_epochs: the key's name in run directories made before issue #32
-    [ -n "$target" ] || target=$(sed -n 's/^ *max_\(updates\|epochs\): *\([0-9]*\).*/\2/p' "$dir/config.yaml" 2>/dev/null | head -1)
-    [ -n "$target" ] || target=$(sed -n 's/^ *max_updates: *\([0-9]*\).*/\1/p' "$(recipe_file "$t")" 2>/dev/null | head -1)
+    # The updates (or off-policy rounds) the run's own config asks for, else its recipe's.
+    [ -n "$target" ] || [ ! -f "$dir/config.yaml" ] ||
+      target=$("$build/tools/masa_config" --run-config "$dir/config.yaml" --rollout 2>/dev/null | sed -n 's/^max_updates: //p')
+    rf=$(recipe_file "$t")
+    [ -n "$target" ] || [ -z "$rf" ] || target=$("$build/tools/masa_config" --set "@$rf" --rollout 2>/dev/null | sed -n 's/^max_updates: //p')
     state=waiting age=0
     if [ -f "$dir/done" ]; then state=done
     elif [ -f "$dir/metrics.csv" ]; then

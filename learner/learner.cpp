@@ -51,10 +51,10 @@ AssemblerConfig assemblerConfig(int64_t run_id, const config::RunConfig& rc, int
   AssemblerConfig a;
   a.term_names = std::move(term_names);
   a.run_id = run_id;
-  a.horizon = rc.ppo.horizon;
+  a.horizon = rc.rollout.horizon;
   a.obs_dim = obs_dim;
   a.act_dim = act_dim;
-  a.max_policy_lag = rc.ppo.max_policy_lag;
+  a.max_policy_lag = rc.rollout.max_policy_lag;
   return a;
 }
 
@@ -66,11 +66,11 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
       dir_(options.run_dir),
       rng_(rc.seed),
       ranks_(options.ranks ? options.ranks : &cluster::soloCommunicator()),
-      rank_envs_(rc.ppo.num_envs / ranks_->size()),
+      rank_envs_(rc.rollout.num_envs / ranks_->size()),
       round_(rc.runner.loss_grace_s),
       delivery_(rc.runner.repeat_unacknowledged_s, rc.runner.republish_every_s, kActorLiveS) {
   MASA_CHECK(!dir_.empty(), "learner: no run directory");
-  MASA_CHECK(rc.ppo.num_envs % ranks_->size() == 0, "ppo.num_envs " << rc.ppo.num_envs << " must divide among the "
+  MASA_CHECK(rc.rollout.num_envs % ranks_->size() == 0, rc.rollout.key("num_envs") << " " << rc.rollout.num_envs << " must divide among the "
                                                                      << ranks_->size() << " learner ranks");
   MASA_CHECK(opt_.rank_check_every > 0, "rank_check_every must be positive, got " << opt_.rank_check_every);
   min_batch_envs_ = static_cast<int>(std::ceil(rc.runner.min_batch_fraction * rank_envs_));
@@ -83,7 +83,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   algorithm_ = opt_.make_algorithm(rc_, rng_, *ranks_);
   MASA_CHECK(ranks_->size() == 1 || algorithm_->dataParallel(),
              "learner: " << rc_.learner << " runs on one learner rank (" << ranks_->size() << " given)");
-  buffer_ = std::make_unique<ppo::RolloutBuffer>(rank_envs_, rc_.ppo.horizon, obs_dim_, act_dim_);
+  buffer_ = std::make_unique<ppo::RolloutBuffer>(rank_envs_, rc_.rollout.horizon, obs_dim_, act_dim_);
 
   run_id_ = options.run_id;
   if (opt_.resume) loadCheckpoint();  // sets run_id_ unless one was given
@@ -203,10 +203,10 @@ void Learner::onChunk(const Verdict& v) {
   if (!collector_) {
     CollectorConfig c;
     c.num_envs = rank_envs_;
-    c.horizon = rc_.ppo.horizon;
+    c.horizon = rc_.rollout.horizon;
     c.obs_dim = obs_dim_;
     c.act_dim = act_dim_;
-    c.max_policy_lag = rc_.ppo.max_policy_lag;
+    c.max_policy_lag = rc_.rollout.max_policy_lag;
     c.term_names = columns_.term_names;  // the task's: the assembler dropped chunks naming others
     collector_ = std::make_unique<BatchCollector>(c);
     collector_->setLearnerVersion(updates_);

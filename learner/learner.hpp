@@ -38,7 +38,6 @@
 #include "learner/update_report.hpp"
 #include "learner/algorithm.hpp"
 #include "learner/ppo/rollout_buffer.hpp"
-#include "learner/ppo_algorithm.hpp"
 #include "learner/silence_watch.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 
@@ -57,7 +56,7 @@ struct LearnerOptions {
   std::optional<transport::SignedMode> signed_mode;
   bool verbose = true;  // one progress line per update on stdout
   // Data-parallel (docs/scaling.md): this process is learner rank ranks->rank() of ranks->size(),
-  // taking ppo.num_envs / size environments of every batch from the actors that send to its
+  // taking rollout.num_envs / size environments of every batch from the actors that send to its
   // rollout_url. Rank 0 alone publishes parameters and stats (on url) and writes the run
   // directory; every rank checks every rank_check_every updates that all hold the same parameters.
   // Null: the only learner.
@@ -65,10 +64,9 @@ struct LearnerOptions {
   std::string rollout_url;  // "" = url
   int rank_check_every = 10;
   // Makes the run's algorithm from the run config, the learner's seeded generator and the ranks:
-  // masa_learner and masa_train pass learner/algorithms' catalog (every `learner` value); the
-  // default runs PPO and refuses the others.
-  std::function<std::unique_ptr<Algorithm>(const config::RunConfig&, Rng&, cluster::Communicator&)> make_algorithm =
-      makePpoAlgorithm;
+  // masa_learner and masa_train pass learner/algorithms' catalog (every `learner` value), a test
+  // or benchmark of PPO alone makePpoAlgorithm. Required: the learner knows no algorithm by name.
+  std::function<std::unique_ptr<Algorithm>(const config::RunConfig&, Rng&, cluster::Communicator&)> make_algorithm;
   // In-process (masa_train): every channel on this bus (a transport::LocalBus: typed messages
   // handed over without encoding), owned by the caller; url, rollout_url and the keys are unused.
   // Null: the learner makes its LCM transports from url and rollout_url.

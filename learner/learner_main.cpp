@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
   url = masa::transport::loopbackUrl();
   app.add_option("--url", url, "LCM provider URL")->capture_default_str();
   app.add_option("--run-id", run_id, "run id actors must carry (default: random, or the checkpoint's)");
-  app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_updates)")
+  app.add_option("--max-updates", max_updates, "stop after this many updates in total (default ppo.max_updates, or sac.env_steps in rounds off-policy)")
       ->check(CLI::NonNegativeNumber);
   std::string key_file;
   bool no_auth = false;
@@ -189,7 +189,7 @@ int main(int argc, char** argv) {
                                      : masa::learner::defaultRunDir(rc.task + "_" + masa::model::methodName(rc.method),
                                                                     rc.seed);
     }
-    if (max_updates < 0) max_updates = rc.ppo.max_updates;
+    if (max_updates < 0) max_updates = rc.rollout.max_updates;
     // Collective over the whole job, whatever the authentication: the actors cannot know it before
     // the plan, and a collective every process of the job enters must not depend on it.
     std::optional<masa::transport::SignedMode> job_keys;

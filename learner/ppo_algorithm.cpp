@@ -50,7 +50,7 @@ double readLrAndOrder(std::istream& is, const std::string& source, std::vector<i
 PpoAlgorithm::PpoAlgorithm(const config::RunConfig& rc, Rng& rng, cluster::Communicator& ranks) : rc_(rc) {
   if (rc.learner != "ppo")
     throw std::runtime_error("learner: " + rc.learner + " is not built into this program (masa_learner and masa_train run it)");
-  const int64_t batch_samples = static_cast<int64_t>(rc.ppo.num_envs) * rc.ppo.horizon;
+  const int64_t batch_samples = static_cast<int64_t>(rc.rollout.num_envs) * rc.rollout.horizon;
   // The user's numbers, not our bug: said without a source line.
   if (rc.ppo.minibatch_size <= 0 || batch_samples % rc.ppo.minibatch_size != 0)
     throw std::runtime_error("ppo.minibatch_size " + std::to_string(rc.ppo.minibatch_size) +

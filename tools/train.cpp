@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
   app.add_option("--configs", configs, "configs directory")->capture_default_str();
   app.add_option("--run-dir", run_dir, "run directory (default runs/<task>_<method>_inprocess_<seed>_<time>)");
   app.add_option("--recipe", recipe, "a recipe of configs/recipes/ (or a YAML file), applied before --set");
-  app.add_option("--updates", updates, "PPO updates to make in total (default: ppo.max_updates)")
+  app.add_option("--updates", updates, "updates (PPO) or rounds (off-policy) to make in total (default: ppo.max_updates, or sac.env_steps in rounds)")
       ->check(CLI::PositiveNumber);
   app.add_option("--threads", threads, "OpenMP threads over the environments")->capture_default_str()
       ->check(CLI::Range(1, 1024));
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
     }
     const auto rc = masa::config::loadRunConfig(configs, overrides, resume.empty() ? "" : resume + "/config.yaml");
     masa::config::checkBatchShape(rc, 1);
-    if (updates == 0) updates = rc.ppo.max_updates;
+    if (updates == 0) updates = rc.rollout.max_updates;
     if (run_dir.empty())
       run_dir = masa::learner::defaultRunDir(rc.task + "_" + masa::model::methodName(rc.method) + "_inprocess", rc.seed);
     std::unique_ptr<masa::transport::MessageBus> bus;
@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
     learner.setMaxUpdates(updates);
 
     masa::actor::ActorOptions ao;
-    ao.num_envs = rc.ppo.num_envs;
+    ao.num_envs = rc.rollout.num_envs;
     ao.run_id = lo.run_id;
     ao.threads = threads;
     ao.incarnation = 1;  // bit-identical chunks from run to run
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     ao.stop = &g_stop;
     masa::actor::Actor actor(rc, ao, bus.get());
     std::fprintf(stderr, "masa_train: %s / %s, %d envs x %d steps per update, %lld updates, run dir %s\n",
-                 rc.task.c_str(), masa::model::methodName(rc.method).c_str(), rc.ppo.num_envs, rc.ppo.horizon,
+                 rc.task.c_str(), masa::model::methodName(rc.method).c_str(), rc.rollout.num_envs, rc.rollout.horizon,
                  static_cast<long long>(updates), learner.runDir().c_str());
     // The environments go beside the learner's checkpoint (actor_state.bin), as they were between
     // the two rollouts the checkpoint lies between: a resume goes on exactly, as if never stopped.

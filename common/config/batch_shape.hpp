@@ -7,7 +7,7 @@
 
 namespace masa::config {
 
-// Throws ConfigError (naming ppo.minibatch_size or ppo.num_envs and the file that set it) where
+// Throws ConfigError (naming ppo.minibatch_size or the learner's num_envs and the file that set it) where
 // the PPO batch of `config` cannot be split as the learner splits it over `learner_ranks` ranks.
 // Off-policy runs have no PPO minibatches and pass.
 void checkBatchShape(const RunConfig& config, int learner_ranks);

@@ -31,6 +31,74 @@ std::string resolveRecipe(const std::string& configs_dir, const std::string& nam
   throw ConfigError(kCommandLine, "@" + name, "no recipe file '" + name + "' nor " + in_configs + " (recipes: " + known + ")");
 }
 
+// The keys that shape the rollouts, as PPO names them and as the off-policy learner does.
+struct ShapeKey {
+  const char* ppo;
+  const char* off_policy;
+};
+constexpr ShapeKey kShapeKeys[] = {
+    {"num_envs", "num_envs"}, {"horizon", "horizon"}, {"max_policy_lag", "max_policy_lag"}, {"max_updates", "env_steps"}};
+
+RolloutShape readPpoShape(const ConfigSection& r) {
+  RolloutShape s;
+  s.section = "ppo";
+  s.num_envs = r.atLeast("ppo.num_envs", 1);
+  s.horizon = r.atLeast("ppo.horizon", 1);
+  s.max_updates = r.atLeast("ppo.max_updates", 1);
+  s.max_policy_lag = r.atLeast("ppo.max_policy_lag", 0);
+  return s;
+}
+
+// Run directories and policy files written before the off-policy learner had its own sizing keys
+// sized it with ppo.*. Where such a file (the base layer) holds ppo.num_envs and no sac.num_envs,
+// those numbers move to the sac section as they were meant (ppo.max_updates rounds become
+// sac.env_steps), so the run reads, and its config.yaml is written, as a new one would be. A
+// recipe or command line that sizes an off-policy run with ppo.* is refused instead
+// (readOffPolicyShape), since nothing wrote it before the change.
+void migrateOffPolicyShape(YAML::Node tree, Origins& origin, const YAML::Node& schema, const std::string& base_file,
+                           const std::string& defaults_file) {
+  const auto from_base = [&](const std::string& key) { return origin.count(key) && origin.at(key) == base_file; };
+  if (!from_base("ppo.num_envs") || origin.count("sac.num_envs")) return;
+  const ConfigSection r(tree, origin, defaults_file);
+  const RolloutShape old = readPpoShape(r);
+  const std::string from = origin.at("ppo.num_envs");
+  YAML::Node sac = tree["sac"], ppo = tree["ppo"];
+  sac["num_envs"] = old.num_envs;
+  sac["horizon"] = old.horizon;
+  sac["max_policy_lag"] = old.max_policy_lag;
+  sac["env_steps"] = static_cast<long long>(old.max_updates) * old.num_envs * old.horizon;
+  for (const ShapeKey& k : kShapeKeys) {
+    ppo[k.ppo] = YAML::Clone(schema["ppo"][k.ppo]);
+    origin.erase(std::string("ppo.") + k.ppo);
+    origin["sac." + std::string(k.off_policy)] = from;
+  }
+}
+
+// The off-policy learner is sized by its own section: sac.num_envs x sac.horizon transitions a
+// round, sac.env_steps of them in all. A task file's ppo.* sizes the task's PPO runs and is not
+// read here; a recipe or command line that sets a PPO sizing key for an off-policy run asks for
+// something that would be silently ignored, so it is refused.
+RolloutShape readOffPolicyShape(const ConfigSection& r, const std::string& defaults_file, const std::string& task_file) {
+  for (const ShapeKey& k : kShapeKeys) {
+    const std::string ppo_key = std::string("ppo.") + k.ppo;
+    const std::string from = r.originOf(ppo_key);
+    if (from == defaults_file || from == task_file) continue;
+    r.fail(ppo_key, std::string("is PPO's: learner off_policy is sized by sac.") + k.off_policy +
+                        " (set that instead, or learner: ppo)");
+  }
+  RolloutShape s;
+  s.section = "sac";
+  s.num_envs = r.atLeast("sac.num_envs", 1);
+  s.horizon = r.atLeast("sac.horizon", 1);
+  s.max_policy_lag = r.atLeast("sac.max_policy_lag", 0);
+  const long long env_steps = r.atLeast("sac.env_steps", 1LL);
+  const long long round = static_cast<long long>(s.num_envs) * s.horizon;
+  const long long rounds = (env_steps + round - 1) / round;
+  if (rounds > 1000000000LL) r.fail("sac.env_steps", "is more than 1e9 rounds of sac.num_envs x sac.horizon");
+  s.max_updates = static_cast<int>(rounds);
+  return s;
+}
+
 }  // namespace
 
 ConfigSection sectionOf(const RunConfig& config, const std::string& prefix) {
@@ -111,9 +179,14 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   for (const auto& [file, node] : recipe_files) layers.overlay(node, file);
   for (const auto& [path, value] : parsed) layers.set(path, value);
   rc.origin = layers.origin();
-  const YAML::Node merged = layers.tree();
+  const YAML::Node merged = YAML::Clone(layers.tree());
+  {
+    const ConfigSection top(merged, rc.origin, defaults_file);
+    if (has_base && top.oneOf("learner", {"ppo", "off_policy"}) == "off_policy")
+      migrateOffPolicyShape(merged, rc.origin, schema, base_file, defaults_file);
+  }
 
-  const ConfigSection r = layers.section();
+  const ConfigSection r(merged, rc.origin, defaults_file);
   rc.task = r.get<std::string>("task", "a task name");
   rc.learner = r.oneOf("learner", {"ppo", "off_policy"});
   try {
@@ -147,8 +220,6 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   m.sasa_value_coef = r.nonNegative("model.sasa_value_coef");
 
   PpoConfig& p = rc.ppo;
-  p.num_envs = r.atLeast("ppo.num_envs", 1);
-  p.horizon = r.atLeast("ppo.horizon", 1);
   p.minibatch_size = r.atLeast("ppo.minibatch_size", 1);
   p.mini_epochs = r.atLeast("ppo.mini_epochs", 1);
   p.learning_rate = r.positive("ppo.learning_rate");
@@ -168,8 +239,7 @@ RunConfig loadRunConfigOver(const std::string& configs_dir, const std::vector<st
   p.normalize_value = r.get<bool>("ppo.normalize_value", "true or false");
   p.normalize_advantage = r.get<bool>("ppo.normalize_advantage", "true or false");
   p.value_bootstrap = r.get<bool>("ppo.value_bootstrap", "true or false");
-  p.max_updates = r.atLeast("ppo.max_updates", 1);
-  p.max_policy_lag = r.atLeast("ppo.max_policy_lag", 0);
+  rc.rollout = rc.learner == "off_policy" ? readOffPolicyShape(r, defaults_file, task_file) : readPpoShape(r);
 
   RunnerConfig& u = rc.runner;
   u.checkpoint_every = r.atLeast("runner.checkpoint_every", 0);

@@ -17,9 +17,9 @@
 
 namespace masa::config {
 
+// PPO's numbers; its rollout shape (ppo.num_envs, ppo.horizon, ppo.max_updates, ppo.max_policy_lag)
+// is read into RunConfig::rollout when PPO is the run's learner.
 struct PpoConfig {
-  int num_envs = 4096;
-  int horizon = 32;
   int minibatch_size = 32768;
   int mini_epochs = 5;
   double learning_rate = 5e-4;
@@ -38,8 +38,19 @@ struct PpoConfig {
   bool normalize_value = true;
   bool normalize_advantage = true;
   bool value_bootstrap = true;
-  int max_updates = 10000;
-  int max_policy_lag = 0;
+};
+
+// How the actors' rollouts are shaped and how many a run takes, read from the section of the run's
+// learner (ppo.* for PPO, sac.* for the off-policy learner), so that an algorithm is sized by its
+// own numbers. Everything that collects rollouts (actors, learner intake, launchers) reads this.
+struct RolloutShape {
+  std::string section = "ppo";  // the section the numbers came from (for messages)
+  int num_envs = 4096;          // environments per batch, over all actors
+  int horizon = 32;             // steps per environment per batch
+  int max_updates = 10000;      // batches (updates, or rounds of the off-policy learner) of a run
+  int max_policy_lag = 0;       // policy versions an actor may act ahead of the learner
+  // "<section>.<key>": the key path a message should name.
+  std::string key(const std::string& name) const { return section + "." + name; }
 };
 
 // The learner's bookkeeping around the algorithm (rsl_rl's "runner").
@@ -54,7 +65,7 @@ struct RunnerConfig {
   // reach its URL) stops every rank, after a checkpoint, instead of leaving them waiting (0: never).
   double rank_silence_stop_s = 120.0;
   int snapshot_every = 0;          // updates between kept policies/policy_uNNNNNN.bin (0: none)
-  // A batch short of lost environments forms once this share of ppo.num_envs arrived and the rest
+  // A batch short of lost environments forms once this share of rollout.num_envs arrived and the rest
   // is known lost (learner/intake/round_tracker.hpp); 1: batches are always full.
   double min_batch_fraction = 0.5;
   double loss_grace_s = 0.01;  // seconds after a rollout's latest chunk before its missing ones count as lost
@@ -73,6 +84,7 @@ struct RunConfig {
   std::string spec_path;  // resolved: absolute or relative to the configs dir's parent
   model::ModelConfig model;
   PpoConfig ppo;
+  RolloutShape rollout;   // from the learner's own section
   RunnerConfig runner;
   YAML::Node env;         // task parameters, read by the task
   YAML::Node resolved;    // the whole merged tree, for the run directory

@@ -12,7 +12,7 @@
 #       [--threads T] [--hostfile FILE] [--updates N] [--run-dir DIR | --resume DIR]
 #       [--auth signed|hmac|none] [--no-auth] [--set key=value ...]
 #       [-- extra mpirun options]
-# Defaults: 2 ranks, 2 actors of 32 environments, 1 thread each; ppo.num_envs = A x E, which the
+# Defaults: 2 ranks, 2 actors of 32 environments, 1 thread each; the learner's num_envs = A x E, which the
 # ranks share equally. --recipe NAME (configs/recipes/NAME.yaml) gives the task, method, updates
 # and environments (split over the actors unless --envs is given). The config's horizon is kept and
 # its minibatch sized for A x E environments (deploy/batch_size.sh; said before the job starts); a
@@ -72,9 +72,10 @@ if [ -n "$recipe" ]; then
   resolved=$("$build/tools/masa_config" --set "@$recipe" "${sets[@]+"${sets[@]}"}") || exit 2
   [ "$task_given" = 1 ] || task=$(sed -n 's/^task: //p' <<< "$resolved")
   [ "$method_given" = 1 ] || method=$(sed -n 's/^method: //p' <<< "$resolved")
-  [ -n "$updates" ] || updates=$(ppo_key max_updates <<< "$resolved")
+  shape=$("$build/tools/masa_config" --rollout --set "@$recipe" "${sets[@]+"${sets[@]}"}") || exit 2
+  [ -n "$updates" ] || updates=$(shape_key max_updates <<< "$shape")
   if [ "$envs_given" = 0 ]; then
-    recipe_envs=$(ppo_key num_envs <<< "$resolved")
+    recipe_envs=$(shape_key num_envs <<< "$shape")
     (( recipe_envs % actors == 0 )) ||
       { echo "mpirun_train.sh: recipe $recipe has $recipe_envs environments, not divisible over $actors actors: give --envs (per actor) or another --actors" >&2; exit 2; }
     envs=$((recipe_envs / actors))
@@ -92,7 +93,7 @@ fi
 config=("${recipe_sets[@]+"${recipe_sets[@]}"}" --set "task=$task" --set "method=$method" "${sets[@]+"${sets[@]}"}")
 if [ -z "$resume" ]; then
   size_batch mpirun_train.sh $((actors * envs)) "${config[@]}" || exit 2
-  config+=(--set "ppo.num_envs=$((actors * envs))" "${batch_sets[@]+"${batch_sets[@]}"}")
+  config+=("${batch_sets[@]+"${batch_sets[@]}"}")
   run_dir=${run_dir:-$(absolute "${MASA_RUNS_DIR:-runs}/${task}_${method}_$(date +%Y%m%d_%H%M%S)")}
   echo "mpirun_train.sh: $task / $method, $ranks learner ranks, $actors actors x $envs envs: $batch_summary${updates:+, $updates updates}, run dir $run_dir"
 else

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # experiments/grid.sh --recipe: every run of the grid is made from the one recipe named (here a
-# YAML file) instead of its task's, runs to that recipe's ppo.max_updates, and the grid remembers
+# YAML file) instead of its task's, runs to that recipe's length (here sac.env_steps: 4 rounds of 8 x 8), and the grid remembers
 # it: a rerun naming another recipe is refused, a recipe that does not exist is refused up front.
 # The recipe is off-policy, so the record (record_grid.sh) is checked to leave its replay state out.
 #   tests/experiments/grid_recipe.sh BUILD_DIR WORK_DIR
@@ -16,8 +16,8 @@ task: a1_beam
 method: masa
 learner: off_policy
 model: {policy_hidden: [16], critic_hidden: [16]}
-sac: {learning_starts: 64, batch_size: 32, policy_hidden: [16], q_hidden: [16], updates_per_step: 0.25}
-ppo: {num_envs: 8, horizon: 8, minibatch_size: 64, max_updates: 4}
+sac: {num_envs: 8, horizon: 8, env_steps: 256, learning_starts: 64, batch_size: 32, policy_hidden: [16], q_hidden: [16],
+      updates_per_step: 0.25}
 runner: {checkpoint_every: 2, eval_every: 2, eval_episodes: 1}
 env: {max_episode_steps: 40, velocity_reward: progress}
 YAML

@@ -33,12 +33,12 @@ for r in rows:
 print(f"{run}: {len(seen)} scalars, each once, {updates} updates")
 PY
 }
-tiny=(--set task=a1_beam --set "model.policy_hidden=[16]" --set "model.critic_hidden=[16]" --set ppo.num_envs=8
-      --set ppo.horizon=8 --set ppo.minibatch_size=64 --set env.max_episode_steps=20 --set runner.checkpoint_every=4
-      --set runner.eval_every=3 --set runner.eval_episodes=1 --set runner.plot_every=0)
-off=(--set learner=off_policy --set sac.learning_starts=64 --set sac.batch_size=16 --set "sac.policy_hidden=[16]" --set "sac.q_hidden=[16]")
+tiny=(--set task=a1_beam --set "model.policy_hidden=[16]" --set "model.critic_hidden=[16]" --set env.max_episode_steps=20
+      --set runner.checkpoint_every=4 --set runner.eval_every=3 --set runner.eval_episodes=1 --set runner.plot_every=0)
+ppo=(--set ppo.num_envs=8 --set ppo.horizon=8 --set ppo.minibatch_size=64)
+off=(--set learner=off_policy --set sac.num_envs=8 --set sac.horizon=8 --set sac.learning_starts=64 --set sac.batch_size=16 --set "sac.policy_hidden=[16]" --set "sac.q_hidden=[16]")
 for case in ppo off_policy; do
-  extra=()
+  extra=("${ppo[@]}")
   [ $case = off_policy ] && extra=("${off[@]}")
   "${train[@]}" --updates 400 --run-dir $case "${tiny[@]}" "${extra[@]}" > $case.log 2>&1 &
   pid=$!

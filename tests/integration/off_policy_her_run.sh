@@ -17,7 +17,7 @@ begin_local_run off_policy_her "$port"
 rounds=12 envs=8 horizon=32 starts=512 ups=0.25
 log "deploy/train.sh trifinger_lift masa, off_policy with hindsight, 2 actors x $envs envs, $rounds rounds, on $url"
 OMP_NUM_THREADS=1 MASA_BUILD_DIR=$build MASA_LCM_URL=$url bash deploy/train.sh trifinger_lift masa --actors 2 --envs $envs \
-  --updates $rounds --run-dir "$run" --set learner=off_policy --set ppo.horizon=$horizon --set sac.her_share=0.8 \
+  --updates $rounds --run-dir "$run" --set learner=off_policy --set sac.horizon=$horizon --set sac.her_share=0.8 \
   --set sac.learning_starts=$starts --set sac.updates_per_step=$ups --set sac.batch_size=64 \
   --set "sac.policy_hidden=[32]" --set "sac.q_hidden=[32]" --set runner.eval_every=0 --set runner.plot_every=0 \
   > "$work/train.log" 2>&1 &

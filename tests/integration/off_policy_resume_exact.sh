@@ -9,7 +9,7 @@
 source "$(dirname "$0")/masa_train_case.sh"
 task=(--set task=a1_beam)
 [ "${3:-}" = her ] && task=(--set task=trifinger_lift --set sac.her_share=0.8)
-tiny=("${task[@]}" --set learner=off_policy --set ppo.num_envs=8 --set ppo.horizon=16 --set env.max_episode_steps=40
+tiny=("${task[@]}" --set learner=off_policy --set sac.num_envs=8 --set sac.horizon=16 --set env.max_episode_steps=40
       --set sac.learning_starts=200 --set sac.updates_per_step=0.25 --set sac.batch_size=16 --set "sac.policy_hidden=[16]"
       --set "sac.q_hidden=[16]" --set sac.n_step=2 --set runner.checkpoint_every=3 --set runner.eval_every=4
       --set runner.eval_episodes=1 --set runner.plot_every=0)

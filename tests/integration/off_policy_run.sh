@@ -21,7 +21,7 @@ begin_local_run off_policy "$port"
 rounds=40 envs=8 horizon=32 starts=1024 ups=0.5
 log "deploy/train.sh a1_beam masa, learner off_policy, 2 actors x $envs envs, $rounds rounds, on $url (work dir $work)"
 OMP_NUM_THREADS=1 MASA_BUILD_DIR=$build MASA_LCM_URL=$url bash deploy/train.sh a1_beam masa --actors 2 --envs $envs \
-  --updates $rounds --run-dir "$run" --set learner=off_policy --set ppo.horizon=$horizon \
+  --updates $rounds --run-dir "$run" --set learner=off_policy --set sac.horizon=$horizon \
   --set sac.learning_starts=$starts --set sac.updates_per_step=$ups --set sac.batch_size=128 \
   --set "sac.policy_hidden=[64,64]" --set "sac.q_hidden=[64,64]" --set runner.eval_every=0 --set runner.plot_every=0 \
   > "$work/train.log" 2>&1 &
@@ -32,7 +32,7 @@ wait "$train_pid" || fail "train.sh did not finish cleanly"
 for a in 0 1; do grep -q "actor $a joined" "$work/train.log" "$run"/*.log 2> /dev/null || fail "actor $a never joined"; done
 
 # Each round's gradient steps (off_policy.csv) are the ones its data owed, and the policy lag stays
-# within ppo.max_policy_lag (0: every round's data acted with the newest parameters).
+# within sac.max_policy_lag (0, the default: every round's data acted with the newest parameters).
 awk -F, -v starts=$starts -v ups=$ups '
   NR == 1 { for (c = 1; c <= NF; c++) col[$c] = c; next }
   { n = NR - 1; got = $col["env_steps"]; owed = got >= starts ? int(ups * (got - starts + 1) + 1e-9) : 0

@@ -5,16 +5,16 @@
 # parameters, for PPO and for learner: off_policy (issue #32, item 5).
 #   tests/integration/train_bus_same_run.sh BUILD_DIR WORK_DIR
 source "$(dirname "$0")/masa_train_case.sh"
-tiny=(--set task=a1_beam --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set ppo.num_envs=8
-      --set ppo.horizon=8 --set ppo.minibatch_size=64 --set env.max_episode_steps=40 --set runner.eval_every=3
-      --set runner.eval_episodes=1 --set runner.plot_every=0)
-off=(--set learner=off_policy --set sac.learning_starts=96 --set sac.batch_size=16 --set sac.policy_hidden=[16]
+tiny=(--set task=a1_beam --set model.policy_hidden=[16] --set model.critic_hidden=[16] --set env.max_episode_steps=40
+      --set runner.eval_every=3 --set runner.eval_episodes=1 --set runner.plot_every=0)
+ppo=(--set ppo.num_envs=8 --set ppo.horizon=8 --set ppo.minibatch_size=64)
+off=(--set learner=off_policy --set sac.num_envs=8 --set sac.horizon=8 --set sac.learning_starts=96 --set sac.batch_size=16 --set sac.policy_hidden=[16]
      --set sac.q_hidden=[16] --set sac.updates_per_step=0.5)
 # The policy file's parameters: what follows its text header (the seal and the build's name differ).
 params() { python3 -c 'import sys; b = open(sys.argv[1], "rb").read(); print(b[b.index(b"# Written by masa"):].split(b"\n", 1)[1].hex())' "$1"; }
 
 for algo in ppo off; do
-  extra=(); [ "$algo" = off ] && extra=("${off[@]}")
+  extra=("${ppo[@]}"); [ "$algo" = off ] && extra=("${off[@]}")
   for bus in local memq; do
     "${train[@]}" --bus "$bus" --updates 8 --run-dir "${algo}_$bus" "${tiny[@]}" "${extra[@]+"${extra[@]}"}" > "${algo}_$bus.log" 2>&1 ||
       fail "$algo over --bus $bus failed"

@@ -43,10 +43,8 @@ void expect(bool ok, const std::string& what) {
   }
 }
 
-config::PpoConfig ppoConfig(int num_envs) {
+config::PpoConfig ppoConfig() {
   config::PpoConfig c;
-  c.num_envs = num_envs;
-  c.horizon = kHorizon;
   c.minibatch_size = 32;  // 4 minibatches of the whole batch, 3 mini-epochs: 12 Adam steps an update
   c.mini_epochs = 3;
   c.learning_rate = 3e-3;
@@ -66,7 +64,7 @@ struct Learner {
     Rng init(11);
     model->initialize(init);
     adam = std::make_unique<nn::Adam<float>>(model->params(), nn::AdamConfig<float>{});  // the learner's defaults
-    trainer = std::make_unique<ppo::PpoTrainer>(*model, *adam, ppoConfig(num_envs), ranks);
+    trainer = std::make_unique<ppo::PpoTrainer>(*model, *adam, ppoConfig(), ranks);
     buffer = std::make_unique<ppo::RolloutBuffer>(num_envs, kHorizon, spec.obsDim(), spec.actDim());
   }
   sym::SymmetrySpec spec;

@@ -538,7 +538,7 @@ TEST(ActorRollouts, BetweenRolloutsTheActorWaitsBoundedForNewerParameters) {
 // last (no wait after the first rollout), but not a third before the first is answered.
 TEST(ActorRollouts, WithPolicyLagOneTheActorCollectsOneRolloutAheadAndWaitsBeforeTheNext) {
   auto rc = smallRolloutConfig(8);
-  rc.ppo.max_policy_lag = 1;
+  rc.rollout.max_policy_lag = 1;
   transport::Transport bus("memq://");
   auto opt = rolloutOptions(2, 3);
   opt.start_without_learner = true;

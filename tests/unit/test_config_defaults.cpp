@@ -24,13 +24,13 @@ TEST(ConfigDefaults, TheRunStructIsTheDefaultsFile) {
                                                            YAML::Load("task: a1_beam"), "the test"),
                           fresh;
   EXPECT_SAME(method); EXPECT_SAME(seed); EXPECT_SAME(learner);
-  EXPECT_SAME(ppo.num_envs); EXPECT_SAME(ppo.horizon); EXPECT_SAME(ppo.minibatch_size); EXPECT_SAME(ppo.mini_epochs);
+  EXPECT_SAME(rollout.num_envs); EXPECT_SAME(rollout.horizon); EXPECT_SAME(rollout.section); EXPECT_SAME(ppo.minibatch_size); EXPECT_SAME(ppo.mini_epochs);
   EXPECT_SAME(ppo.learning_rate); EXPECT_SAME(ppo.lr_schedule); EXPECT_SAME(ppo.kl_threshold); EXPECT_SAME(ppo.lr_min);
   EXPECT_SAME(ppo.lr_max); EXPECT_SAME(ppo.gamma); EXPECT_SAME(ppo.tau); EXPECT_SAME(ppo.e_clip);
   EXPECT_SAME(ppo.entropy_coef); EXPECT_SAME(ppo.critic_coef); EXPECT_SAME(ppo.bounds_loss_coef);
   EXPECT_SAME(ppo.soft_bound); EXPECT_SAME(ppo.grad_norm); EXPECT_SAME(ppo.normalize_value);
-  EXPECT_SAME(ppo.normalize_advantage); EXPECT_SAME(ppo.value_bootstrap); EXPECT_SAME(ppo.max_updates);
-  EXPECT_SAME(ppo.max_policy_lag);
+  EXPECT_SAME(ppo.normalize_advantage); EXPECT_SAME(ppo.value_bootstrap); EXPECT_SAME(rollout.max_updates);
+  EXPECT_SAME(rollout.max_policy_lag);
   EXPECT_SAME(runner.checkpoint_every); EXPECT_SAME(runner.republish_every_s); EXPECT_SAME(runner.plot_every);
   EXPECT_SAME(runner.eval_every); EXPECT_SAME(runner.eval_episodes); EXPECT_SAME(runner.silence_warn_s);
   EXPECT_SAME(runner.rank_silence_stop_s); EXPECT_SAME(runner.snapshot_every); EXPECT_SAME(runner.min_batch_fraction);

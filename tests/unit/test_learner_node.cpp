@@ -24,6 +24,7 @@
 #include "common/transport/message_auth.hpp"
 #include "actors/rollout_chunker.hpp"
 #include "learner/learner.hpp"
+#include "learner/ppo_algorithm.hpp"
 #include "learner/run_directory.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 #include "masa/lcmt_learner_stats.hpp"
@@ -48,6 +49,7 @@ fs::path freshDir(const std::string& name) {
 
 LearnerOptions nodeOptions(const fs::path& dir, int64_t run_id) {
   LearnerOptions o;
+  o.make_algorithm = makePpoAlgorithm;
   o.url = "memq://";
   o.run_dir = dir.string();
   o.run_id = run_id;
@@ -62,7 +64,7 @@ struct FakeActor {
 
   FakeActor(const config::RunConfig& rc, uint64_t seed) {
     const auto spec = sym::SymmetrySpec::load(rc.spec_path);
-    const int E = rc.ppo.num_envs, T = rc.ppo.horizon, od = spec.obsDim(), ad = spec.actDim();
+    const int E = rc.rollout.num_envs, T = rc.rollout.horizon, od = spec.obsDim(), ad = spec.actDim();
     rollout.allocate(E, T, od, ad, {"keypoints", "reach", "termination"});  // the task's terms
     rollout.clearEvents();
     std::mt19937_64 rng(seed);

@@ -27,6 +27,7 @@
 #include "common/transport/roster.hpp"
 #include "common/transport/transport.hpp"
 #include "learner/learner.hpp"
+#include "learner/ppo_algorithm.hpp"
 #include "masa/lcmt_policy_params.hpp"
 #include "masa/lcmt_rollout_chunk.hpp"
 #include "test_transport_support.hpp"
@@ -400,6 +401,7 @@ TEST(MessageSignActors, AParameterMessageSignedByAnActorsKeyIsRefusedByEveryActo
 
 learner::LearnerOptions learnerOptions(const fs::path& dir, const SignedRun& run) {
   learner::LearnerOptions o;
+  o.make_algorithm = learner::makePpoAlgorithm;
   o.url = "memq://";
   o.run_dir = dir.string();
   o.run_id = kSignedRunId;
@@ -411,7 +413,7 @@ learner::LearnerOptions learnerOptions(const fs::path& dir, const SignedRun& run
 // A whole batch (8 environments x 4 steps) of actor `actor_id`'s rollout `seq`, encoded.
 std::vector<std::vector<uint8_t>> signedBatchOf(const config::RunConfig& rc, int actor_id, int64_t seq) {
   const auto spec = sym::SymmetrySpec::load(rc.spec_path);
-  const int E = rc.ppo.num_envs, T = rc.ppo.horizon, od = spec.obsDim(), ad = spec.actDim();
+  const int E = rc.rollout.num_envs, T = rc.rollout.horizon, od = spec.obsDim(), ad = spec.actDim();
   rollout::Rollout r;
   r.allocate(E, T, od, ad, {"keypoints", "reach", "termination"});
   r.clearEvents();

@@ -106,16 +106,15 @@ Curve train(model::Method method) {
   Rng rng(1234);
   model.initialize(rng);
   nn::Adam<float> adam(model.params());
+  constexpr int kEnvs = 64, kHorizon = 8;
   config::PpoConfig ppo;
-  ppo.num_envs = 64;
-  ppo.horizon = 8;
   ppo.minibatch_size = 128;
   ppo.mini_epochs = 4;
   ppo.learning_rate = 3e-3;
   ppo.kl_threshold = 0.008;
   PpoTrainer trainer(model, adam, ppo);
-  RolloutBuffer buffer(ppo.num_envs, ppo.horizon, spec.obsDim(), spec.actDim());
-  MirrorBandit env(ppo.num_envs, rng);
+  RolloutBuffer buffer(kEnvs, kHorizon, spec.obsDim(), spec.actDim());
+  MirrorBandit env(kEnvs, rng);
 
   constexpr int kUpdates = 40, kLast = 5;
   Curve c;

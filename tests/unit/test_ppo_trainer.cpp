@@ -20,8 +20,6 @@ constexpr int kInvariantObs = 1;  // torso_z of the mirror spec: unchanged by th
 
 config::PpoConfig smallPpo() {
   config::PpoConfig c;
-  c.num_envs = kEnvs;
-  c.horizon = kHorizon;
   c.minibatch_size = 32;
   c.mini_epochs = 4;
   c.learning_rate = 1e-3;
@@ -41,7 +39,7 @@ struct Rig {
     model->initialize(rng);
     adam = std::make_unique<nn::Adam<float>>(model->params());
     trainer = std::make_unique<PpoTrainer>(*model, *adam, ppo);
-    buffer = std::make_unique<RolloutBuffer>(ppo.num_envs, ppo.horizon, spec.obsDim(), spec.actDim());
+    buffer = std::make_unique<RolloutBuffer>(kEnvs, kHorizon, spec.obsDim(), spec.actDim());
   }
   sym::SymmetrySpec spec;
   std::unique_ptr<model::ActorCritic<float>> model;

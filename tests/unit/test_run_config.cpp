@@ -55,8 +55,8 @@ TEST(RunConfig, EveryShippedTaskLoadsWithThePapersHyperparameters) {
   for (const auto& w : wants) {
     const RunConfig c = loadRunConfig(kConfigs, {std::string("task=") + w.task});
     EXPECT_EQ(c.task, w.task);
-    EXPECT_EQ(c.ppo.num_envs, w.envs) << w.task;
-    EXPECT_EQ(c.ppo.horizon, w.horizon) << w.task;
+    EXPECT_EQ(c.rollout.num_envs, w.envs) << w.task;
+    EXPECT_EQ(c.rollout.horizon, w.horizon) << w.task;
     EXPECT_EQ(c.ppo.minibatch_size, w.minibatch) << w.task;
     EXPECT_EQ(c.ppo.mini_epochs, w.epochs) << w.task;
     EXPECT_DOUBLE_EQ(c.ppo.learning_rate, w.lr) << w.task;
@@ -74,7 +74,7 @@ TEST(RunConfig, CommandLineOverridesTaskFileWhichOverridesDefaults) {
   const RunConfig c = loadRunConfig(kConfigs, {"task=a1_beam", "method=SASA", "ppo.horizon=8",
                                                "model.policy_hidden=[64, 32]", "seed=17", "env.target_speed=0.5"});
   EXPECT_EQ(c.method, model::Method::kSasa);
-  EXPECT_EQ(c.ppo.horizon, 8);
+  EXPECT_EQ(c.rollout.horizon, 8);
   EXPECT_EQ(c.model.policy_hidden, (std::vector<int>{64, 32}));
   EXPECT_EQ(c.seed, 17u);
   EXPECT_DOUBLE_EQ(c.env["target_speed"].as<double>(), 0.5);
@@ -96,10 +96,78 @@ TEST_F(ScratchConfigs, EnvSectionsMergeAcrossTaskFileAndCommandLine) {
 TEST_F(ScratchConfigs, TheOldNameMaxEpochsIsReadAsMaxUpdates) {
   writeTask("t", "ppo:\n  max_epochs: 7\n");
   const RunConfig c = loadRunConfig(dir_.string(), {"task=t"});
-  EXPECT_EQ(c.ppo.max_updates, 7);
-  EXPECT_EQ(loadRunConfig(dir_.string(), {"task=t", "ppo.max_epochs=9"}).ppo.max_updates, 9);
-  EXPECT_EQ(loadRunConfig(dir_.string(), {"task=t", "ppo.max_updates=11"}).ppo.max_updates, 11);
+  EXPECT_EQ(c.rollout.max_updates, 7);
+  EXPECT_EQ(loadRunConfig(dir_.string(), {"task=t", "ppo.max_epochs=9"}).rollout.max_updates, 9);
+  EXPECT_EQ(loadRunConfig(dir_.string(), {"task=t", "ppo.max_updates=11"}).rollout.max_updates, 11);
   EXPECT_EQ(dumpResolved(c).find("max_epochs"), std::string::npos);
+}
+
+// Issue #54: an algorithm is sized by its own section. The off-policy learner's rounds are
+// sac.num_envs x sac.horizon transitions, sac.env_steps of them in all; PPO's batch is ppo.*.
+TEST_F(ScratchConfigs, EachLearnerIsSizedByItsOwnSection) {
+  writeTask("t", "");
+  const RunConfig ppo = loadRunConfig(dir_.string(), {"task=t", "ppo.num_envs=8", "ppo.horizon=4", "ppo.max_updates=5"});
+  EXPECT_EQ(ppo.rollout.section, "ppo");
+  EXPECT_EQ(ppo.rollout.num_envs, 8);
+  EXPECT_EQ(ppo.rollout.horizon, 4);
+  EXPECT_EQ(ppo.rollout.max_updates, 5);
+  const RunConfig off = loadRunConfig(dir_.string(), {"task=t", "learner=off_policy", "sac.num_envs=8", "sac.horizon=4",
+                                                      "sac.env_steps=100", "sac.max_policy_lag=1"});
+  EXPECT_EQ(off.rollout.section, "sac");
+  EXPECT_EQ(off.rollout.num_envs, 8);
+  EXPECT_EQ(off.rollout.horizon, 4);
+  EXPECT_EQ(off.rollout.max_updates, 4) << "100 env steps are 4 rounds of 32, the last one short";
+  EXPECT_EQ(off.rollout.max_policy_lag, 1);
+  EXPECT_EQ(off.rollout.key("num_envs"), "sac.num_envs");
+}
+
+// A PPO sizing key given to an off-policy run would be ignored; it is refused, naming the key to set.
+TEST_F(ScratchConfigs, APpoSizingKeyGivenToTheOffPolicyLearnerIsRefusedNamingItsOwn) {
+  writeTask("t", "");
+  for (const auto& [set, own] : std::vector<std::pair<std::string, std::string>>{
+           {"ppo.num_envs=8", "sac.num_envs"}, {"ppo.horizon=4", "sac.horizon"},
+           {"ppo.max_updates=5", "sac.env_steps"}, {"ppo.max_policy_lag=1", "sac.max_policy_lag"}}) {
+    try {
+      loadRunConfig(dir_.string(), {"task=t", "learner=off_policy", set});
+      ADD_FAILURE() << set << " was accepted for learner off_policy";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), set.substr(0, set.find('=')));
+      EXPECT_EQ(e.file(), "command line");
+      EXPECT_NE(std::string(e.what()).find(own), std::string::npos) << e.what();
+    }
+  }
+  // A task file's PPO batch sizes the task's PPO runs and does not stand in the way of off-policy ones.
+  writeTask("u", "ppo:\n  num_envs: 16384\n  horizon: 8\n");
+  const RunConfig u = loadRunConfig(dir_.string(), {"task=u", "learner=off_policy"});
+  EXPECT_EQ(u.rollout.num_envs, 64);
+  EXPECT_EQ(u.rollout.horizon, 16);
+}
+
+// Run directories and policy files written before (off-policy sized by ppo.*) read as they were
+// meant, and are written back in the new form, which reads the same.
+TEST_F(ScratchConfigs, AnOldOffPolicyRunConfigIsReadWithItsPpoSizing) {
+  writeTask("t", "");
+  const fs::path old = dir_ / "config.yaml";
+  std::ofstream(old) << "task: t\nlearner: off_policy\nppo:\n  num_envs: 64\n  horizon: 16\n  max_updates: 5500\n"
+                        "  max_policy_lag: 1\nsac:\n  env_steps: 1000000\n  algorithm: td3\n";
+  const RunConfig c = loadRunConfig(dir_.string(), {}, old.string());
+  EXPECT_EQ(c.rollout.section, "sac");
+  EXPECT_EQ(c.rollout.num_envs, 64);
+  EXPECT_EQ(c.rollout.horizon, 16);
+  EXPECT_EQ(c.rollout.max_updates, 5500);
+  EXPECT_EQ(c.rollout.max_policy_lag, 1);
+  const fs::path again = dir_ / "again.yaml";
+  std::ofstream(again) << dumpResolved(c);
+  const RunConfig d = loadRunConfig(dir_.string(), {}, again.string());
+  EXPECT_EQ(d.rollout.num_envs, 64);
+  EXPECT_EQ(d.rollout.horizon, 16);
+  EXPECT_EQ(d.rollout.max_updates, 5500);
+  EXPECT_EQ(d.rollout.max_policy_lag, 1);
+  EXPECT_EQ(d.resolved["sac"]["algorithm"].as<std::string>(), "td3");
+  // A PPO run's old config is PPO's, untouched.
+  const fs::path old_ppo = dir_ / "ppo.yaml";
+  std::ofstream(old_ppo) << "task: t\nppo:\n  num_envs: 64\n  horizon: 16\n";
+  EXPECT_EQ(loadRunConfig(dir_.string(), {}, old_ppo.string()).rollout.num_envs, 64);
 }
 
 TEST_F(ScratchConfigs, UnknownKeyInTaskFileNamesTheFileAndTheKey) {
