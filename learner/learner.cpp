@@ -17,10 +17,10 @@
 #include "common/integrity/sealed_file.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/sim/policy_evaluator.hpp"
-#include "learner/checkpoint.hpp"
+#include "learner/run_dir/checkpoint.hpp"
 #include "learner/intake/drop_reason.hpp"
-#include "learner/metrics_csv.hpp"
-#include "learner/run_directory.hpp"
+#include "learner/run_dir/metrics_csv.hpp"
+#include "learner/run_dir/run_directory.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
 #include "common/transport/channels.hpp"
 #include "masa/lcmt_policy_params.hpp"
@@ -89,8 +89,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   if (opt_.resume) loadCheckpoint();  // sets run_id_ unless one was given
   // Rewritten on resume too: overrides given then are part of the run from now on.
   if (isLeadRank()) {
-    std::ofstream(fs::path(dir_) / "config.yaml") << config::dumpResolved(rc_);
-    openEventFile();
+    openRunFiles();
   }
   if (run_id_ == 0) run_id_ = randomRunId();
   if (ranks_->size() > 1) {
@@ -385,13 +384,11 @@ void Learner::update() {
   if (rc_.runner.snapshot_every > 0 && updates_ % rc_.runner.snapshot_every == 0) writeSnapshot();
 }
 
-void Learner::openEventFile() {
-  events_ = std::make_unique<EventFile>(dir_);
+void Learner::openRunFiles() {
   // The configuration as text, at the step the run (re)starts from: a resume's overrides show.
-  events_->text("config", env_steps_, preformatted(config::dumpResolved(rc_)));
-  metrics_events_ = std::make_unique<CsvEvents>(*events_, (fs::path(dir_) / "metrics.csv").string(), "env_steps", "learn");
+  files_ = std::make_unique<RunFiles>(dir_, config::dumpResolved(rc_), env_steps_, RunFiles::Metrics{"env_steps", "learn"});
   if (const std::string table = algorithm_->roundTable(); !table.empty())
-    round_events_ = std::make_unique<CsvEvents>(*events_, (fs::path(dir_) / table).string(), "env_steps",
+    round_events_ = std::make_unique<CsvEvents>(files_->events(), files_->path(table), "env_steps",
                                                 fs::path(table).stem().string(), std::vector<std::string>{"update"});
 }
 
@@ -404,8 +401,18 @@ void Learner::report() {
   const CollectorStats& c = collector_->stats();
   publisher().publish(transport::kLearnerStatsChannel,
                       statsMessage(report_, columns_, run_id_, dropStats(), c.envs_stale, c.envs_overflow));
-  appendMetricsRow((fs::path(dir_) / "metrics.csv").string(), report_, columns_);
-  metrics_events_->mirrorLastRow();
+  if (!metrics_open_) {
+    // A resumed run's rows follow those kept to its checkpoint; a run that never reported starts the file.
+    const fs::path csv = files_->path("metrics.csv");
+    if (fs::exists(csv) && fs::file_size(csv) > 0) {
+      files_->continueMetrics();
+    } else {
+      files_->startMetrics(metricsHeader(columns_));
+    }
+    metrics_open_ = true;
+  }
+  writeMetricsRow(files_->metrics(), report_);
+  files_->endRow();
   if (!curve_)
     curve_ = std::make_unique<LearningCurve>(
         dir_, LearningCurve::Script{algorithm_->curveScript(rc_.task + " / " + model::methodName(rc_.method),

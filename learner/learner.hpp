@@ -31,9 +31,10 @@
 #include "learner/intake/batch_collector.hpp"
 #include "learner/intake/rollout_assembler.hpp"
 #include "learner/intake/round_tracker.hpp"
-#include "learner/csv_events.hpp"
-#include "learner/event_file.hpp"
-#include "learner/learning_curve.hpp"
+#include "learner/run_dir/csv_events.hpp"
+#include "learner/run_dir/event_file.hpp"
+#include "learner/run_dir/run_files.hpp"
+#include "learner/run_dir/learning_curve.hpp"
 #include "learner/params_delivery.hpp"
 #include "learner/update_report.hpp"
 #include "learner/algorithm.hpp"
@@ -149,7 +150,7 @@ class Learner {
   // Tells the update: the stats message, metrics.csv, the curve, the progress line.
   void report();
   bool curveHasData() const;  // every panel of the learning curve has a point to draw
-  void openEventFile();  // rank 0: the run's TensorBoard event file, with the config as text
+  void openRunFiles();  // rank 0: config.yaml, metrics.csv and the TensorBoard event file (run_dir/run_files.hpp)
   void loadCheckpoint();
   void evaluate();
   double wallTime() const;
@@ -191,8 +192,9 @@ class Learner {
   std::chrono::steady_clock::time_point idle_since_;  // the end of the last update (or the start): what wait_s counts from
   std::unique_ptr<LearningCurve> curve_;  // made with the first update: it needs the reward terms
   // TensorBoard: the run's event file, fed with every row of metrics.csv and of the algorithm's round table (rank 0).
-  std::unique_ptr<EventFile> events_;
-  std::unique_ptr<CsvEvents> metrics_events_, round_events_;
+  std::unique_ptr<RunFiles> files_;  // config.yaml, metrics.csv and the events (rank 0)
+  bool metrics_open_ = false;
+  std::unique_ptr<CsvEvents> round_events_;
   int64_t max_updates_ = -1;              // of the current run(), for the ETA; -1: unknown
   double update_interval_s_ = 0;          // moving average of the wall time between updates
   UpdateReport report_;

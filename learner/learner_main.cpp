@@ -33,7 +33,7 @@
 #include "common/transport/run_key.hpp"
 #include "learner/intake/drop_reason.hpp"
 #include "learner/learner.hpp"
-#include "learner/run_directory.hpp"
+#include "learner/run_dir/run_directory.hpp"
 #include "learner/algorithms/algorithm_catalog.hpp"
 
 namespace {

@@ -12,8 +12,8 @@
 #include "common/core/check.hpp"
 #include "common/policy/policy_file.hpp"
 #include "common/symmetry/symmetry_spec.hpp"
-#include "learner/checkpoint.hpp"
-#include "learner/learning_curve.hpp"
+#include "learner/run_dir/checkpoint.hpp"
+#include "learner/run_dir/learning_curve.hpp"
 
 namespace masa::learner {
 namespace {

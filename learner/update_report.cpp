@@ -82,18 +82,18 @@ masa::lcmt_learner_stats statsMessage(const UpdateReport& report, const ReportCo
   return s;
 }
 
-void appendMetricsRow(const std::string& path, const UpdateReport& report, const ReportColumns& columns) {
-  namespace fs = std::filesystem;
-  const bool fresh = !fs::exists(path) || fs::file_size(path) == 0;
-  std::ofstream f(path, std::ios::app);
-  if (fresh) {
-    f << "update,env_steps,wall_time_s,fps,return,length,success";
-    for (const auto& t : columns.term_names) f << ",term_" << t;
-    f << ",actor_loss,critic_loss,entropy,bounds_loss,sym_policy,sym_value,kl,lr,grad_norm,explained_variance,dropped_chunks,dropped_envs";
-    f << ",eval_return,eval_length,eval_success";
-    for (const auto& n : columns.progress_names) f << ",eval_" << n;
-    f << '\n';
-  }
+std::vector<std::string> metricsHeader(const ReportColumns& columns) {
+  std::vector<std::string> h{"update", "env_steps", "wall_time_s", "fps", "return", "length", "success"};
+  for (const auto& t : columns.term_names) h.push_back("term_" + t);
+  for (const char* n : {"actor_loss", "critic_loss", "entropy", "bounds_loss", "sym_policy", "sym_value", "kl", "lr",
+                        "grad_norm", "explained_variance", "dropped_chunks", "dropped_envs", "eval_return", "eval_length",
+                        "eval_success"})
+    h.push_back(n);
+  for (const auto& n : columns.progress_names) h.push_back("eval_" + n);
+  return h;
+}
+
+void writeMetricsRow(std::ostream& f, const UpdateReport& report) {
   const LearnFigures& p = report.learned;
   f.precision(9);
   f << report.update << ',' << report.env_steps << ',' << report.wall_time_s << ','

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 #include <utility>
 #include <vector>
@@ -63,8 +64,10 @@ struct ReportColumns {
 masa::lcmt_learner_stats statsMessage(const UpdateReport& report, const ReportColumns& columns, int64_t run_id,
                                       const DropStats& chunk_drops, int64_t stale_envs, int64_t overflow_envs);
 
-// Appends the update's row to metrics.csv (with the header when the file is new or empty).
-void appendMetricsRow(const std::string& path, const UpdateReport& report, const ReportColumns& columns);
+// metrics.csv's columns, and the update's row in them (written to the run's open metrics.csv,
+// learner/run_dir/run_files.hpp).
+std::vector<std::string> metricsHeader(const ReportColumns& columns);
+void writeMetricsRow(std::ostream& out, const UpdateReport& report);
 
 // The progress line (and the evaluation's line when the update had one). `max_updates` <= 0: no
 // total and no ETA; `update_interval_s` is the recent wall time per update.

@@ -22,7 +22,7 @@
 #include "common/render/offscreen_renderer.hpp"
 #include "common/render/strip_sampler.hpp"
 #include "common/sim/policy_evaluator.hpp"
-#include "learner/checkpoint.hpp"
+#include "learner/run_dir/checkpoint.hpp"
 #include "learner/ppo_algorithm.hpp"
 #include "tasks/tasks.hpp"
 

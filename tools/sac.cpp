@@ -8,7 +8,7 @@
 
 #include "common/core/build_info.hpp"
 #include "common/core/config_error.hpp"
-#include "learner/run_directory.hpp"
+#include "learner/run_dir/run_directory.hpp"
 #include "learner/sac/sac_run.hpp"
 
 using namespace masa;

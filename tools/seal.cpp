@@ -17,7 +17,7 @@
 #include "common/integrity/ed25519_keys.hpp"
 #include "common/integrity/sealed_file.hpp"
 #include "common/policy/policy_file.hpp"
-#include "learner/checkpoint.hpp"
+#include "learner/run_dir/checkpoint.hpp"
 
 using namespace masa;
 

@@ -28,7 +28,7 @@
 #include "common/transport/local_bus.hpp"
 #include "common/transport/transport.hpp"
 #include "learner/learner.hpp"
-#include "learner/run_directory.hpp"
+#include "learner/run_dir/run_directory.hpp"
 #include "learner/algorithms/algorithm_catalog.hpp"
 
 namespace {

@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-#include "learner/learning_curve.hpp"
+#include "learner/run_dir/learning_curve.hpp"
 
 namespace masa::offline {
 namespace {

@@ -9,9 +9,9 @@
 
 #include "common/model/method.hpp"
 #include "common/policy/policy_file.hpp"
-#include "learner/csv_events.hpp"
-#include "learner/event_file.hpp"
-#include "learner/learning_curve.hpp"
+#include "learner/run_dir/run_files.hpp"
+#include "learner/run_dir/event_file.hpp"
+#include "learner/run_dir/learning_curve.hpp"
 #include "learner/offline/bc_trainer.hpp"
 #include "learner/offline/iql_trainer.hpp"
 #include "learner/offline/normalizer_fit.hpp"
@@ -63,9 +63,7 @@ struct OfflineRun::Impl {
   std::vector<double> sums;                  // their sums since the last row
   std::unique_ptr<task::TaskFactory> factory;
   std::vector<std::string> progress_names;
-  std::ofstream csv;
-  std::unique_ptr<learner::EventFile> events;  // TensorBoard
-  std::unique_ptr<learner::CsvEvents> csv_events;
+  std::unique_ptr<learner::RunFiles> files;  // config.yaml, metrics.csv and their TensorBoard events
   std::unique_ptr<learner::LearningCurve> curve;
   double reward_scale = 1.0;  // IQL's TD target multiplies rewards by it
 
@@ -102,23 +100,15 @@ struct OfflineRun::Impl {
   }
 
   void openRunDir() {
-    fs::create_directories(opt.run_dir);
-    std::ofstream(fs::path(opt.run_dir) / "config.yaml") << config::dumpResolved(rc);
-    csv.open(fs::path(opt.run_dir) / "metrics.csv");
-    if (!csv) throw std::runtime_error(opt.run_dir + "/metrics.csv: cannot write");
-    csv << "step,wall_s,steps_per_s";
-    for (const auto& n : losses) csv << ',' << n;
-    for (const auto& n : figures) csv << ',' << n;
-    if (iql) csv << ",actor_lr";
-    csv << ",eval_return,eval_length,eval_success";
-    for (const auto& n : progress_names) csv << ",eval_" << n;
-    csv << '\n';
-    csv.precision(7);
-    // TensorBoard: the rows at their gradient step, and the config as text.
-    events = std::make_unique<learner::EventFile>(opt.run_dir);
-    events->text("config", 0, learner::preformatted(config::dumpResolved(rc)));
-    csv_events = std::make_unique<learner::CsvEvents>(*events, (fs::path(opt.run_dir) / "metrics.csv").string(), "step",
-                                                      "offline");
+    files = std::make_unique<learner::RunFiles>(opt.run_dir, config::dumpResolved(rc), 0,
+                                                learner::RunFiles::Metrics{"step", "offline"});
+    std::vector<std::string> header{"step", "wall_s", "steps_per_s"};
+    header.insert(header.end(), losses.begin(), losses.end());
+    header.insert(header.end(), figures.begin(), figures.end());
+    if (iql) header.push_back("actor_lr");
+    for (const char* n : {"eval_return", "eval_length", "eval_success"}) header.push_back(n);
+    for (const auto& n : progress_names) header.push_back("eval_" + n);
+    files->startMetrics(header);
     const std::string title = rc.task + "  " + algoName(oc.algo) + " / " +
                               (oc.augment ? std::string("sasa-data") : model::methodName(rc.method)) + "  seed " +
                               std::to_string(rc.seed) + "  (" + std::to_string(data.size()) + " transitions)";
@@ -154,6 +144,7 @@ struct OfflineRun::Impl {
   }
 
   void writeRow(long long step, double wall, double sps, int steps_in_row, const task::EvalSummary* eval) {
+    std::ofstream& csv = files->metrics();
     csv << step << ',' << wall << ',' << sps;
     for (double& v : sums) {
       csv << ',' << (steps_in_row > 0 ? v / steps_in_row : std::nan(""));
@@ -168,8 +159,7 @@ struct OfflineRun::Impl {
       for (size_t i = 0; i < progress_names.size(); ++i) csv << ",nan";
     }
     csv << '\n';
-    csv.flush();
-    csv_events->mirrorLastRow();
+    files->endRow();
   }
 
   void printProgress(long long step, double wall, double sps, int steps_in_row, const task::EvalSummary* eval) const {

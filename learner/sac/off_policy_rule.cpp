@@ -13,7 +13,7 @@
 #include "common/core/binary_io.hpp"
 #include "common/core/check.hpp"
 #include "common/model/method.hpp"
-#include "learner/learning_curve.hpp"
+#include "learner/run_dir/learning_curve.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_policy_file.hpp"
 #include "learner/sac/trainer_factory.hpp"

@@ -11,9 +11,9 @@
 #include "common/core/binary_io.hpp"
 #include "common/model/method.hpp"
 #include "common/sim/registry.hpp"
-#include "learner/csv_events.hpp"
-#include "learner/event_file.hpp"
-#include "learner/run_directory.hpp"
+#include "learner/run_dir/event_file.hpp"
+#include "learner/run_dir/run_files.hpp"
+#include "learner/run_dir/run_directory.hpp"
 #include "learner/sac/hindsight.hpp"
 #include "learner/sac/sac_critic_maps.hpp"
 #include "learner/sac/sac_policy_file.hpp"
@@ -51,9 +51,7 @@ struct SacRun::Impl {
   std::unique_ptr<task::Task> env;
   std::unique_ptr<Hindsight> hindsight;  // goal relabeling of the batches (off: the replay's own draws)
   std::vector<std::string> progress_names;
-  std::ofstream csv;
-  std::unique_ptr<learner::EventFile> events;  // TensorBoard: metrics.csv's rows and the config
-  std::unique_ptr<learner::CsvEvents> csv_events;
+  std::unique_ptr<learner::RunFiles> files;  // config.yaml, metrics.csv and their TensorBoard events
   long long t_done = 0;    // environment steps taken
   std::vector<float> obs;  // the observation the next action is chosen from
 
@@ -77,34 +75,22 @@ struct SacRun::Impl {
     progress_names = env->progressNames();
     obs.resize(spec.obsDim());
     if (!opt.resume) learner::refuseRunDirInUse(opt.run_dir);
-    fs::create_directories(opt.run_dir);
-    std::ofstream(fs::path(opt.run_dir) / "config.yaml") << config::dumpResolved(rc);
+    const learner::RunFiles::Metrics columns{"env_step", sc.algorithm};
     if (opt.resume) {
       loadState();
-      csv.open(fs::path(opt.run_dir) / "metrics.csv", std::ios::app);
-      if (!csv) throw std::runtime_error(opt.run_dir + "/metrics.csv: cannot append");
-      csv.precision(7);
       learner::truncateEventFile((fs::path(opt.run_dir) / learner::EventFile::kFileName).string(), t_done);
-      openEvents(config);
+      files = std::make_unique<learner::RunFiles>(opt.run_dir, config::dumpResolved(rc), t_done, columns);
+      files->continueMetrics();
       return;
     }
     env->reset(rng);
     env->observe(obs.data());
-    csv.open(fs::path(opt.run_dir) / "metrics.csv");
-    if (!csv) throw std::runtime_error(opt.run_dir + "/metrics.csv: cannot write");
-    csv << "env_step,updates,wall_s,env_steps_per_s,train_return,train_length,episodes,q_loss,actor_loss,alpha_loss,"
-           "symmetry_loss,alpha,mean_q,entropy,eval_return,eval_length";
-    for (const auto& n : progress_names) csv << ",eval_" << n;
-    csv << '\n';
-    csv.precision(7);
-    openEvents(config);
-  }
-
-  void openEvents(const config::RunConfig& config) {
-    events = std::make_unique<learner::EventFile>(opt.run_dir);
-    events->text("config", t_done, learner::preformatted(config::dumpResolved(config)));
-    csv_events = std::make_unique<learner::CsvEvents>(*events, (fs::path(opt.run_dir) / "metrics.csv").string(), "env_step",
-                                                      sc.algorithm);
+    files = std::make_unique<learner::RunFiles>(opt.run_dir, config::dumpResolved(rc), 0, columns);
+    std::vector<std::string> header{"env_step", "updates",   "wall_s", "env_steps_per_s", "train_return", "train_length",
+                                    "episodes", "q_loss",    "actor_loss", "alpha_loss", "symmetry_loss", "alpha",
+                                    "mean_q",   "entropy",   "eval_return", "eval_length"};
+    for (const auto& n : progress_names) header.push_back("eval_" + n);
+    files->startMetrics(header);
   }
 
   static constexpr char kMagic[8] = {'M', 'A', 'S', 'A', 'S', 'R', 'U', 'N'};
@@ -272,21 +258,21 @@ SacRunResult SacRun::run() {
     if (eval_now) e = m.evaluate();
     const double nu = static_cast<double>(std::max<long long>(updates_in_row, 1));
     const double ne = static_cast<double>(episodes_in_row);
-    m.csv << t << ',' << m.trainer->steps() << ',' << wall << ',' << sps << ','
+    std::ofstream& csv = m.files->metrics();
+    csv << t << ',' << m.trainer->steps() << ',' << wall << ',' << sps << ','
           << (ne > 0 ? ret_sum / ne : std::nan("")) << ',' << (ne > 0 ? len_sum / ne : std::nan("")) << ','
           << episodes_in_row;
     for (double v : {sums.q_loss, sums.actor_loss, sums.alpha_loss, sums.symmetry_loss, sums.alpha, sums.mean_q, sums.entropy})
-      m.csv << ',' << (updates_in_row > 0 ? v / nu : std::nan(""));
+      csv << ',' << (updates_in_row > 0 ? v / nu : std::nan(""));
     if (eval_now) {
-      m.csv << ',' << e.ret << ',' << e.length;
-      for (double p : e.progress) m.csv << ',' << p;
+      csv << ',' << e.ret << ',' << e.length;
+      for (double p : e.progress) csv << ',' << p;
     } else {
-      m.csv << ",nan,nan";
-      for (size_t i = 0; i < m.progress_names.size(); ++i) m.csv << ",nan";
+      csv << ",nan,nan";
+      for (size_t i = 0; i < m.progress_names.size(); ++i) csv << ",nan";
     }
-    m.csv << '\n';
-    m.csv.flush();
-    m.csv_events->mirrorLastRow();
+    csv << '\n';
+    m.files->endRow();
     if (m.opt.verbose) {
       std::printf("env step %lld/%lld (%.0f%%)  %.0f steps/s  elapsed %s  ETA %s  updates %lld", t, sc.env_steps,
                   100.0 * t / sc.env_steps, sps, duration(wall).c_str(), duration((sc.env_steps - t) / sps).c_str(),

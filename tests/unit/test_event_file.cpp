@@ -1,4 +1,4 @@
-// TensorBoard event files (learner/event_file.hpp, learner/csv_events.hpp): records read back with
+// TensorBoard event files (learner/run_dir/event_file.hpp, learner/run_dir/csv_events.hpp): records read back with
 // their CRCs checked, a flipped byte found, a torn tail tolerated and cut on resume, CSV rows as
 // grouped scalars; an independent decoder (Python's protobuf, with the Event schema declared in
 // the test) reads the same file; a run killed and resumed has every scalar once, in step order.
@@ -10,8 +10,8 @@
 #include <map>
 #include <string>
 
-#include "learner/csv_events.hpp"
-#include "learner/event_file.hpp"
+#include "learner/run_dir/csv_events.hpp"
+#include "learner/run_dir/event_file.hpp"
 
 namespace masa::learner {
 namespace {

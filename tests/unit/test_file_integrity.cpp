@@ -22,7 +22,7 @@
 #include "common/transport/channels.hpp"
 #include "file_mutations.hpp"
 #include "common/nn/adam.hpp"
-#include "learner/checkpoint.hpp"
+#include "learner/run_dir/checkpoint.hpp"
 
 namespace masa {
 namespace {

@@ -14,7 +14,7 @@
 #include "common/core/binary_io.hpp"
 #include "common/integrity/sealed_file.hpp"
 #include "learner/algorithms/algorithm_catalog.hpp"
-#include "learner/checkpoint.hpp"
+#include "learner/run_dir/checkpoint.hpp"
 #include "learner/ppo_algorithm.hpp"
 
 namespace masa {

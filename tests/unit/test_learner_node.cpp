@@ -25,7 +25,7 @@
 #include "actors/rollout_chunker.hpp"
 #include "learner/learner.hpp"
 #include "learner/ppo_algorithm.hpp"
-#include "learner/run_directory.hpp"
+#include "learner/run_dir/run_directory.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 #include "masa/lcmt_learner_stats.hpp"
 #include "masa/lcmt_policy_params.hpp"

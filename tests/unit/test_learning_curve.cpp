@@ -8,7 +8,7 @@
 
 #include <unistd.h>
 
-#include "learner/learning_curve.hpp"
+#include "learner/run_dir/learning_curve.hpp"
 #include "test_temp_dir.hpp"
 
 namespace masa::learner {

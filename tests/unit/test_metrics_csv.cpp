@@ -1,4 +1,4 @@
-// metrics.csv cut back to a checkpoint's update on resume (learner/metrics_csv.hpp).
+// metrics.csv cut back to a checkpoint's update on resume (learner/run_dir/metrics_csv.hpp).
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "learner/metrics_csv.hpp"
+#include "learner/run_dir/metrics_csv.hpp"
 
 namespace masa::learner {
 namespace {

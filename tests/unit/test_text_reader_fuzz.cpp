@@ -26,7 +26,7 @@
 #include "common/integrity/ed25519_keys.hpp"
 #include "common/sim/registry.hpp"
 #include "tasks/tasks.hpp"
-#include "learner/metrics_csv.hpp"
+#include "learner/run_dir/metrics_csv.hpp"
 
 namespace fs = std::filesystem;
 

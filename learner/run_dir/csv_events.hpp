@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "learner/event_file.hpp"
+#include "learner/run_dir/event_file.hpp"
 
 namespace masa::learner {
 

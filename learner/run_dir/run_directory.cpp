@@ -1,4 +1,4 @@
-#include "learner/run_directory.hpp"
+#include "learner/run_dir/run_directory.hpp"
 
 #include <ctime>
 #include <filesystem>

@@ -1,4 +1,4 @@
-#include "learner/learning_curve.hpp"
+#include "learner/run_dir/learning_curve.hpp"
 
 #include <cctype>
 #include <cerrno>

@@ -1,4 +1,4 @@
-#include "learner/metrics_csv.hpp"
+#include "learner/run_dir/metrics_csv.hpp"
 
 #include <algorithm>
 #include <charconv>

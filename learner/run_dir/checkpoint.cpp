@@ -1,4 +1,4 @@
-#include "learner/checkpoint.hpp"
+#include "learner/run_dir/checkpoint.hpp"
 
 #include <cstring>
 #include <filesystem>

@@ -1,4 +1,4 @@
-#include "learner/csv_events.hpp"
+#include "learner/run_dir/csv_events.hpp"
 
 #include <algorithm>
 #include <cmath>

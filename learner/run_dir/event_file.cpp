@@ -1,4 +1,4 @@
-#include "learner/event_file.hpp"
+#include "learner/run_dir/event_file.hpp"
 
 #include <array>
 #include <chrono>
