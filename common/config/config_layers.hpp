@@ -13,7 +13,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "common/config/config_section.hpp"
+#include "common/core/config_section.hpp"
 
 namespace masa::config {
 

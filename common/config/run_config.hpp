@@ -12,7 +12,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "common/config/config_section.hpp"
+#include "common/core/config_section.hpp"
 #include "common/model/actor_critic.hpp"
 
 namespace masa::config {

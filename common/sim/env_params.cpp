@@ -1,103 +1,62 @@
 #include "common/sim/env_params.hpp"
 
-#include <cmath>
-
-#include <sstream>
-
 #include "common/core/config_error.hpp"
 
 namespace masa::task {
+namespace {
+
+YAML::Node underEnv(const YAML::Node& env) {
+  YAML::Node root(YAML::NodeType::Map);
+  root["env"] = env;
+  return root;
+}
+
+}  // namespace
 
 EnvParams::EnvParams(YAML::Node env, std::map<std::string, std::string> origin, std::string default_origin)
-    : env_(std::move(env)), origin_(std::move(origin)), default_origin_(std::move(default_origin)) {
+    : env_(std::move(env)), reader_(underEnv(env_), std::move(origin), default_origin, "env") {
   if (env_.IsDefined() && !env_.IsNull() && !env_.IsMap())
-    throw ConfigError(default_origin_, "env", "expected a mapping of task parameters");
+    throw ConfigError(default_origin, "env", "expected a mapping of task parameters");
 }
 
-YAML::Node EnvParams::lookup(const std::string& path) const {
-  YAML::Node n;
-  n.reset(env_);
-  std::stringstream ss(path);
-  std::string part;
-  while (std::getline(ss, part, '.')) {
-    if (!n.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
-    YAML::Node next = n[part];
-    if (!next.IsDefined()) return next;
-    n.reset(next);
-  }
-  return n;
-}
-
-std::string EnvParams::originOf(const std::string& path) const {
-  auto it = origin_.find("env." + path);
-  if (it != origin_.end()) return it->second;
-  // A whole sub-map (e.g. env.weights) may have been set at once.
-  for (const auto& [k, v] : origin_)
-    if (("env." + path).rfind(k + ".", 0) == 0) return v;
-  return default_origin_;
+bool EnvParams::given(const std::string& key) {
+  asked_.insert(key);
+  const YAML::Node n = reader_.node(key);
+  return n.IsDefined() && !n.IsNull();
 }
 
 double EnvParams::number(const std::string& key, double fallback) {
-  asked_.insert(key);
-  const YAML::Node n = lookup(key);
-  if (!n.IsDefined() || n.IsNull()) return fallback;
-  double v = 0;
-  try {
-    v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    throw ConfigError(originOf(key), "env." + key, "expected a number, got '" + YAML::Dump(n) + "'");
-  }
-  // YAML spells NaN and infinity (.nan, .inf): a reward weight or a gain of either poisons a run.
-  if (!std::isfinite(v)) throw ConfigError(originOf(key), "env." + key, "expected a finite number, got '" + YAML::Dump(n) + "'");
-  return v;
+  return given(key) ? reader_.number(key) : fallback;
 }
 
 double EnvParams::positive(const std::string& key, double fallback) {
   const double v = number(key, fallback);
-  if (!(v > 0)) throw ConfigError(originOf(key), "env." + key, "must be positive, got " + std::to_string(v));
+  if (!(v > 0)) reader_.fail(key, "must be positive, got " + config::formatNumber(v));
   return v;
 }
 
 int EnvParams::integer(const std::string& key, int fallback, int min_value) {
-  asked_.insert(key);
-  const YAML::Node n = lookup(key);
-  int v = fallback;
-  if (n.IsDefined() && !n.IsNull()) {
-    try {
-      v = n.as<int>();
-    } catch (const YAML::Exception&) {
-      throw ConfigError(originOf(key), "env." + key, "expected an integer, got '" + YAML::Dump(n) + "'");
-    }
-  }
-  if (v < min_value)
-    throw ConfigError(originOf(key), "env." + key, "must be at least " + std::to_string(min_value) + ", got " + std::to_string(v));
-  return v;
+  if (given(key)) return reader_.atLeast(key, min_value);
+  if (fallback < min_value)
+    reader_.fail(key, "must be at least " + std::to_string(min_value) + ", got " + std::to_string(fallback));
+  return fallback;
 }
 
 bool EnvParams::flag(const std::string& key, bool fallback) {
-  asked_.insert(key);
-  const YAML::Node n = lookup(key);
-  if (!n.IsDefined() || n.IsNull()) return fallback;
-  try {
-    return n.as<bool>();
-  } catch (const YAML::Exception&) {
-    throw ConfigError(originOf(key), "env." + key, "expected true or false, got '" + YAML::Dump(n) + "'");
-  }
+  return given(key) ? reader_.get<bool>(key, "true or false") : fallback;
 }
 
 std::string EnvParams::text(const std::string& key, const std::string& fallback) {
-  asked_.insert(key);
-  const YAML::Node n = lookup(key);
-  if (!n.IsDefined() || n.IsNull()) return fallback;
-  if (!n.IsScalar()) throw ConfigError(originOf(key), "env." + key, "expected a string");
-  return n.Scalar();
+  if (!given(key)) return fallback;
+  if (!reader_.node(key).IsScalar()) reader_.fail(key, "expected a string");
+  return reader_.get<std::string>(key, "a string");
 }
 
 double EnvParams::weight(const std::string& term, double fallback) { return number("weights." + term, fallback); }
 
 YAML::Node EnvParams::section(const std::string& key) {
   asked_.insert(key);
-  return lookup(key);
+  return reader_.node(key);
 }
 
 void EnvParams::finish() const {
@@ -115,7 +74,7 @@ void EnvParams::finish() const {
       } else {
         std::string known;
         for (const auto& a : asked_) known += (known.empty() ? "" : ", ") + a;
-        throw ConfigError(originOf(key), "env." + key, "unknown task parameter (known: " + known + ")");
+        reader_.fail(key, "unknown task parameter (known: " + known + ")");
       }
     }
   }

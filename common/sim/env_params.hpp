@@ -1,6 +1,8 @@
 // Typed reader of a task's `env` section. The task asks for every parameter it knows (with its
 // default); finish() then rejects any key it never asked for, so a misspelt reward weight is an
-// error naming the file and the key instead of a silently ignored setting.
+// error naming the file and the key instead of a silently ignored setting. The reads themselves
+// (types, finiteness, ranges, the error's file and key path) are the run config's reader's
+// (common/core/config_section.hpp): one reader, one error format.
 #pragma once
 
 #include <map>
@@ -9,6 +11,8 @@
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
+
+#include "common/core/config_section.hpp"
 
 namespace masa::task {
 
@@ -32,12 +36,12 @@ class EnvParams {
   void finish() const;  // throws ConfigError for keys never asked for
 
  private:
-  YAML::Node lookup(const std::string& path) const;
-  std::string originOf(const std::string& path) const;
+  // The value at `key` when a layer gave one (not null), after noting that the task knows the key.
+  bool given(const std::string& key);
+  std::string originOf(const std::string& key) const { return reader_.originOf(key); }
 
   YAML::Node env_;
-  std::map<std::string, std::string> origin_;
-  std::string default_origin_;
+  config::ConfigSection reader_;  // over {env: env_}, at "env"
   std::set<std::string> asked_;
 };
 

@@ -1,5 +1,7 @@
 #include "common/symmetry/spec_parser.hpp"
 
+#include "common/core/config_section.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -44,9 +46,9 @@ class Parser {
   }
 
  private:
+  // The config reader's error (common/core/config_section.hpp): file, key path, why, line.
   [[noreturn]] void fail(const std::string& key, std::string msg, const YAML::Node& where) const {
-    if (where.IsDefined() && !where.Mark().is_null()) msg += " (line " + std::to_string(where.Mark().line + 1) + ")";
-    throw ConfigError(src_, key, msg);
+    config::failAt(src_, key, where, std::move(msg));
   }
 
   static std::string child(const std::string& path, const std::string& key) {

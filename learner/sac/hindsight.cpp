@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "common/config/config_section.hpp"
+#include "common/core/config_section.hpp"
 #include "common/core/check.hpp"
 
 namespace masa::sac {

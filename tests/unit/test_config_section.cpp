@@ -9,6 +9,8 @@
 #include "common/config/config_layers.hpp"
 #include "common/config/nearest_name.hpp"
 #include "common/core/config_error.hpp"
+#include "common/core/config_section.hpp"
+#include "common/sim/env_params.hpp"
 #include "config_error_support.hpp"
 
 namespace masa::config {
@@ -185,6 +187,30 @@ TEST(NearestName, FindsOneTypoAwayAndNothingFarAway) {
   EXPECT_EQ(nearestName("tua", known), "tau");
   EXPECT_EQ(nearestName("xyz", known), "");
   EXPECT_EQ(nearestName("learning_rate", known), "");
+}
+
+}  // namespace
+}  // namespace masa::config
+
+namespace masa::config {
+namespace {
+
+// Issue #54 item 3: the task's `env` reader, the YAML task reader and the spec parser read values
+// as the run config's reader does, with one error format: file, key path, why, and the line.
+TEST(OneConfigReader, TheRunAndTaskReadersGiveTheSameErrorForTheSameBadValue) {
+  const YAML::Node file = YAML::Load("env:\n  kp: fast\n  kd: .nan\n");
+  const ConfigSection run(file, {}, "t.yaml", "env");
+  task::EnvParams env(file["env"], {}, "t.yaml");
+  for (const char* key : {"kp", "kd"}) {
+    const ConfigError a = test::configErrorOf([&] { run.number(key); });
+    const ConfigError b = test::configErrorOf([&] { env.number(key, 1.0); });
+    EXPECT_EQ(std::string(a.what()), std::string(b.what())) << key;
+    EXPECT_EQ(b.key(), std::string("env.") + key);
+    EXPECT_EQ(b.file(), "t.yaml");
+    EXPECT_NE(std::string(b.what()).find("(line "), std::string::npos) << b.what();
+  }
+  const ConfigError range = test::configErrorOf([&] { env.positive("kp_missing", -1.0); });
+  EXPECT_NE(std::string(range.what()).find("must be positive, got -1"), std::string::npos) << range.what();
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The `offline` section is read by the strict config reader (common/config/config_section.hpp):
+// The `offline` section is read by the strict config reader (common/core/config_section.hpp):
 // every number finite, errors naming offline.<key> and where it was set.
 #include <gtest/gtest.h>
 

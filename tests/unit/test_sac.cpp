@@ -544,7 +544,7 @@ TEST(SacConfigTest, DefaultsReadAndUnknownOrBadKeysAreErrorsNamingTheKey) {
   }
 }
 
-// Before the shared reader (common/config/config_section.hpp) a sac number without a range took
+// Before the shared reader (common/core/config_section.hpp) a sac number without a range took
 // NaN and positive() took infinity.
 TEST(SacConfigTest, NaNOrInfinityIsRefusedNamingTheKeyPath) {
   const std::string configs = std::string(MASA_SOURCE_DIR) + "/configs";

@@ -1,16 +1,10 @@
 #include "common/sim/yaml/yaml_fields.hpp"
 
 #include <algorithm>
-#include <cmath>
 
 #include "common/core/config_error.hpp"
 
 namespace masa::task {
-
-void failAt(const std::string& file, const std::string& path, const YAML::Node& node, std::string what) {
-  if (node.IsDefined() && !node.Mark().is_null()) what += " (line " + std::to_string(node.Mark().line + 1) + ")";
-  throw ConfigError(file, path, what);
-}
 
 YamlFields::YamlFields(const YAML::Node& node, std::string path, std::string file,
                        const std::vector<std::string>& allowed)
@@ -44,15 +38,7 @@ std::string YamlFields::text(const std::string& key, const std::string& fallback
 
 double YamlFields::number(const std::string& key) const {
   if (!has(key)) fail("", "missing required key '" + key + "'");
-  double v = 0;
-  try {
-    v = node_[key].as<double>();
-  } catch (const YAML::Exception&) {
-    fail(key, "expected a number, got '" + YAML::Dump(node_[key]) + "'");
-  }
-  // YAML spells NaN and infinity (.nan, .inf); no gain, target or noise of a task means either.
-  if (!std::isfinite(v)) fail(key, "expected a finite number, got '" + YAML::Dump(node_[key]) + "'");
-  return v;
+  return config::readValue<double>(node_[key], file_, pathOf(key), "a number");
 }
 
 double YamlFields::number(const std::string& key, double fallback) const {

@@ -1,12 +1,15 @@
 // Reading one mapping of a hand-written YAML file with errors a user can act on: every key must be
 // one the reader knows (a typo is an error listing the valid keys, never a silent default), and
-// every error names the file, the key path and the line.
+// every error names the file, the key path and the line. Values are read as the run config's are
+// (config::readValue: types, finiteness, one error format).
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
+
+#include "common/core/config_section.hpp"
 
 namespace masa::task {
 
@@ -33,7 +36,8 @@ class YamlFields {
   std::string path_, file_;
 };
 
-// The error for `node` at `path` of `file`, with the node's line when it has one.
-[[noreturn]] void failAt(const std::string& file, const std::string& path, const YAML::Node& node, std::string what);
+// The error for `node` at `path` of `file`, with the node's line when it has one: the config
+// reader's (common/core/config_section.hpp).
+using config::failAt;
 
 }  // namespace masa::task

@@ -28,6 +28,10 @@ T readValue(const YAML::Node& n, const std::string& file, const std::string& pat
 // "0.5", "1e+06": numbers in errors as a user would write them.
 std::string formatNumber(double v);
 
+// The one error of every config reader (run, task `env`, YAML task and spec files): the file, the
+// key path and why, with the node's line where the file gave one.
+[[noreturn]] void failAt(const std::string& file, const std::string& path, const YAML::Node& node, std::string what);
+
 class ConfigSection {
  public:
   // `root` is the whole resolved tree, `prefix` this section's key path in it ("" for the root).
@@ -86,13 +90,13 @@ T readValue(const YAML::Node& n, const std::string& file, const std::string& pat
   try {
     v = n.as<T>();
   } catch (const YAML::Exception&) {
-    throw ConfigError(file, path, "expected " + what + ", got '" + YAML::Dump(n) + "'");
+    failAt(file, path, n, "expected " + what + ", got '" + YAML::Dump(n) + "'");
   }
   bool finite = true;
   if constexpr (std::is_floating_point_v<T>) finite = std::isfinite(v);
   if constexpr (detail::IsFloatList<T>::value)
     for (const auto x : v) finite = finite && std::isfinite(x);
-  if (!finite) throw ConfigError(file, path, "expected a finite number, got '" + YAML::Dump(n) + "'");
+  if (!finite) failAt(file, path, n, "expected a finite number, got '" + YAML::Dump(n) + "'");
   return v;
 }
 

@@ -1,4 +1,4 @@
-#include "common/config/config_section.hpp"
+#include "common/core/config_section.hpp"
 
 #include <sstream>
 
@@ -8,6 +8,11 @@ std::string formatNumber(double v) {
   std::ostringstream os;
   os << v;
   return os.str();
+}
+
+void failAt(const std::string& file, const std::string& path, const YAML::Node& node, std::string what) {
+  if (node.IsDefined() && !node.Mark().is_null()) what += " (line " + std::to_string(node.Mark().line + 1) + ")";
+  throw ConfigError(file, path, what);
 }
 
 ConfigSection::ConfigSection(YAML::Node root, Origins origin, std::string default_file, std::string prefix)
@@ -90,7 +95,7 @@ std::string ConfigSection::oneOf(const std::string& key, const std::vector<std::
 }
 
 void ConfigSection::fail(const std::string& key, const std::string& what) const {
-  throw ConfigError(originOf(key), path(key), what);
+  failAt(originOf(key), path(key), node(key), what);
 }
 
 }  // namespace masa::config
