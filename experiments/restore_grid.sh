@@ -38,6 +38,13 @@ find "$out" -mindepth 3 -maxdepth 3 -name actor_state.bin.xz -exec xz -d {} + ||
   rm -rf "$out"
   echo "restore_grid.sh: unpacking a run's environments (actor_state.bin.xz) failed; nothing restored" >&2; exit 1
 }
+# Records keep their per-update CSVs compressed (experiments/README.md, "The tree's budget"): the
+# runs get them back as the learner wrote them, and their curve scripts read them so again.
+find "$out" -name '*.csv.xz' -exec xz -d {} + || {
+  rm -rf "$out"
+  echo "restore_grid.sh: unpacking a run's metrics (*.csv.xz) failed; nothing restored" >&2; exit 1
+}
+find "$out" -name '*.gp' -exec sed -i 's/"< xz -dc \([^"]*\.csv\)\.xz"/"\1"/g' {} +
 
 finished=0 going_on=0 afresh=0
 for t in $tasks; do for m in $methods; do for s in $seeds; do

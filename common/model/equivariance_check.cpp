@@ -2,11 +2,17 @@
 
 #include "common/model/diag_gaussian.hpp"
 
+#include <limits>
+
 namespace masa::model {
 namespace {
+// A NaN or infinite output is no symmetry: the error is then infinite (maxCoeff and std::max would
+// drop a NaN, and a policy whose mean held a NaN passed with error 0).
 template <typename A, typename B>
 double maxRelativeError(const A& got, const B& want) {
-  return ((got - want).array().abs() / (want.array().abs() + 1.0)).maxCoeff();
+  const Eigen::ArrayXXd err = (got - want).array().abs() / (want.array().abs() + 1.0);
+  if (!err.allFinite()) return std::numeric_limits<double>::infinity();
+  return err.maxCoeff();
 }
 }  // namespace
 

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include <unistd.h>
@@ -93,6 +94,27 @@ TEST(PolicyFile, AMasaPolicyWhoseSpecWasSwappedFailsTheEquivarianceCheckOnLoad) 
   mean[0] = 3.0f;  // trunk_y is odd under the mirror: a non-zero mean breaks the symmetry
   p.model->obsNormalizer().setMeanStd(mean.data(), std.data());
   EXPECT_THROW(checkPolicySymmetry(p), std::runtime_error);
+}
+
+TEST(PolicyFile, AMasaPolicyWithANonFiniteOutputFailsTheEquivarianceCheck) {
+  // MASA is equivariant by construction for any finite parameters; a NaN or infinite one makes
+  // outputs that are no symmetry's image. The check dropped NaN errors (error 0) and let a policy
+  // whose mean held a NaN through masa_eval, masa_deploy and masa_export (issue #54).
+  const config::RunConfig rc = smallPolicyConfig("a1_beam", "masa");
+  const auto spec = sym::SymmetrySpec::load(rc.spec_path);
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    LoadedPolicy p;
+    p.config = rc;
+    p.spec = spec;
+    p.source = "test";
+    p.model = std::make_unique<model::ActorCritic<float>>(spec, rc.model);
+    Rng rng(5);
+    p.model->initialize(rng);
+    EXPECT_LT(checkPolicySymmetry(p), 1e-5);
+    auto& values = p.model->params().values();
+    values(values.size() - 1) = bad;  // the last parameter (the critic's output bias)
+    EXPECT_THROW(checkPolicySymmetry(p), std::runtime_error) << bad;
+  }
 }
 
 // docs/inputs.md gap 3: an env setting of NaN or infinity (a reward weight, a gain) is refused

@@ -12,30 +12,30 @@ set style data linespoints
 set pointsize 0.4
 # Updates in which no episode ended have no return: the CSV says nan there.
 set title "mean episode return"
-plot "metrics.csv" using "env_steps":"return" pt 7 lw 2 title "return (training)", \
+plot "< xz -dc metrics.csv.xz" using "env_steps":"return" pt 7 lw 2 title "return (training)", \
      "" using "env_steps":"eval_return" with points pt 5 ps 0.9 title "return (policy mean)"
 set title "mean episode length and success rate"
 set ytics nomirror
 set y2tics
 set y2range [0:1]
-plot "metrics.csv" using "env_steps":"length" pt 7 title "length", \
+plot "< xz -dc metrics.csv.xz" using "env_steps":"length" pt 7 title "length", \
      "" using "env_steps":(column("success") < 0 ? NaN : column("success")) axes x1y2 pt 7 title "success"
 unset y2tics
 set ytics mirror
 set title "reward terms (mean per episode)"
 set key top left font ",8"
-plot for [t in "velocity alive heading action lateral termination"] "metrics.csv" using "env_steps":(column("term_".t)) pt 7 title t
+plot for [t in "velocity alive heading action lateral termination"] "< xz -dc metrics.csv.xz" using "env_steps":(column("term_".t)) pt 7 title t
 set key top left font ",10"
 set title "losses"
-plot "metrics.csv" using "env_steps":"actor_loss" pt 7 title "actor", \
+plot "< xz -dc metrics.csv.xz" using "env_steps":"actor_loss" pt 7 title "actor", \
      "" using "env_steps":"critic_loss" pt 7 title "critic"
 set title "KL and learning rate"
 set logscale y
-plot "metrics.csv" using "env_steps":"kl" pt 7 title "KL(old||new)", \
+plot "< xz -dc metrics.csv.xz" using "env_steps":"kl" pt 7 title "KL(old||new)", \
      "" using "env_steps":"lr" pt 7 title "learning rate"
 unset logscale y
 set title "throughput"
-plot "metrics.csv" using "env_steps":"fps" pt 7 title "env steps / s"
+plot "< xz -dc metrics.csv.xz" using "env_steps":"fps" pt 7 title "env steps / s"
 unset multiplot
 set output
 # Renamed only when complete, so a viewer never sees half a picture.

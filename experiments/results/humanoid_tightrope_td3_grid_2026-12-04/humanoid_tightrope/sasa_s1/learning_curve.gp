@@ -13,22 +13,22 @@ set style data linespoints
 set pointsize 0.4
 # Updates in which no episode ended have no return: the CSV says nan there.
 set title "mean episode return"
-plot "metrics.csv" using (column("env_steps")/1e6):"return" pt 7 lw 2 title "return (training)", \
+plot "< xz -dc metrics.csv.xz" using (column("env_steps")/1e6):"return" pt 7 lw 2 title "return (training)", \
      "" using (column("env_steps")/1e6):"eval_return" with points pt 5 ps 0.9 title "return (policy mean)"
 set title "mean episode length"
-plot "metrics.csv" using (column("env_steps")/1e6):"length" pt 7 title "length"
+plot "< xz -dc metrics.csv.xz" using (column("env_steps")/1e6):"length" pt 7 title "length"
 set title "reward terms (mean per episode)"
 set key font ",8"
-plot for [t in "velocity alive up heading action energy lateral termination"] "metrics.csv" using (column("env_steps")/1e6):(column("term_".t)) pt 7 title t
+plot for [t in "velocity alive up heading action energy lateral termination"] "< xz -dc metrics.csv.xz" using (column("env_steps")/1e6):(column("term_".t)) pt 7 title t
 set key font ",10"
 set title "losses"
-plot "metrics.csv" using (column("env_steps")/1e6):"actor_loss" pt 7 title "actor", \
+plot "< xz -dc metrics.csv.xz" using (column("env_steps")/1e6):"actor_loss" pt 7 title "actor", \
      "" using (column("env_steps")/1e6):"critic_loss" pt 7 title "critic"
 set title "policy entropy and twin-Q loss"
-plot "metrics.csv" using (column("env_steps")/1e6):"entropy" pt 7 title "entropy (SAC)", \
+plot "< xz -dc metrics.csv.xz" using (column("env_steps")/1e6):"entropy" pt 7 title "entropy (SAC)", \
      "" using (column("env_steps")/1e6):"critic_loss" pt 7 title "twin-Q loss"
 set title "throughput"
-plot "metrics.csv" using (column("env_steps")/1e6):"fps" pt 7 title "env steps / s"
+plot "< xz -dc metrics.csv.xz" using (column("env_steps")/1e6):"fps" pt 7 title "env steps / s"
 unset multiplot
 set output
 # Renamed only when complete, so a viewer never sees half a picture.
