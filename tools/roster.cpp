@@ -4,7 +4,10 @@
 //                                                   (mode 0600, directory 0700), and RUN_DIR/roster
 //                                                   with their public keys and the channels of each role
 //   masa_roster show ROSTER                          the senders, their key fingerprints and channels
-// make keeps what is there: a resumed run keeps its keys, and more actors get keys of their own.
+// make keeps what is there: a resumed run keeps its keys, and more actors get keys of their own. It
+// keeps only what it wrote (issue #55, item 4): every line of an existing roster must carry the
+// public key of RUN_DIR/keys/<role><index>.key and its role's channels; a line no key file of ours
+// backs (one someone planted, or a key swapped) is refused with the line named, never adopted.
 // With --actors given, actors beyond K leave the roster, their key files removed (issue #55, item 3): a run resumed with
 // fewer actors must not go on believing the ones it no longer runs, whose hosts still hold their
 // keys and whose recorded chunks would verify as current data. Brought back later, an actor index
@@ -53,12 +56,41 @@ int retireActorsFrom(transport::Roster& roster, int actors, const fs::path& keys
   return static_cast<int>(retired.size());
 }
 
+std::string keyStem(const fs::path& keys, transport::SenderId id) {
+  return (keys / (std::string(transport::roleName(id.role)) + std::to_string(id.index))).string();
+}
+
+// Throws unless every entry is one make wrote: its private key file is here, checked as any key
+// (owner, mode, directory), it gives the entry's public key, and the entry has its role's channels.
+void refuseEntriesNotOurs(const transport::Roster& roster, const fs::path& keys) {
+  for (const transport::Roster::Entry& e : roster.entries()) {
+    const std::string key_path = keyStem(keys, e.id) + ".key";
+    const std::string planted = "roster " + roster.source() + ": the line of " + e.id.name() + " (" +
+                                integrity::keyFingerprint(e.key) + ") is not one masa_roster wrote: ";
+    const std::string advice = "; a roster line masa_roster did not write is never adopted (remove the line, or the "
+                               "roster and keys to start afresh)";
+    if (!fs::exists(key_path)) throw std::runtime_error(planted + "there is no private key " + key_path + advice);
+    const integrity::SigningKey key = integrity::SigningKey::load(key_path);
+    if (key.publicKey() != e.key)
+      throw std::runtime_error(planted + "its key is not the one of " + key_path + " (" +
+                               integrity::keyFingerprint(key.publicKey()) + ")" + advice);
+    if (e.channels != transport::defaultChannels(e.id.role))
+      throw std::runtime_error(planted + "its channels are not those masa_roster gives " +
+                               std::string(transport::roleName(e.id.role)) + "s" + advice);
+  }
+}
+
 int make(const std::string& dir, int actors, bool actors_given, bool runner, bool robot) {
   const fs::path run(dir), keys = run / "keys", roster_path = run / "roster";
   fs::create_directories(keys);
   ::chmod(keys.c_str(), 0700);
   transport::Roster roster;
   if (fs::exists(roster_path)) roster = transport::Roster::load(roster_path.string());
+  {
+    // What stays is checked before anything is removed: a refused roster leaves the keys as they were.
+    std::vector<transport::SenderId> leaving;
+    refuseEntriesNotOurs(actors_given ? roster.withoutActorsFrom(static_cast<uint32_t>(actors), leaving) : roster, keys);
+  }
   const int retired = actors_given ? retireActorsFrom(roster, actors, keys) : 0;
   std::vector<transport::SenderId> wanted = {{transport::Role::kLearner, 0}};
   for (int a = 0; a < actors; ++a) wanted.push_back({transport::Role::kActor, static_cast<uint32_t>(a)});
@@ -67,7 +99,7 @@ int make(const std::string& dir, int actors, bool actors_given, bool runner, boo
   int made = 0;
   for (const transport::SenderId& id : wanted) {
     if (roster.find(id)) continue;
-    const std::string stem = (keys / (std::string(transport::roleName(id.role)) + std::to_string(id.index))).string();
+    const std::string stem = keyStem(keys, id);
     const integrity::PublicKeyBytes key = integrity::generateKeyPair(stem + ".key", stem + ".pub");
     roster.add(id, key, transport::defaultChannels(id.role));
     ++made;
