@@ -3,6 +3,10 @@
 //                                                   a key per process, RUN_DIR/keys/<role><index>.key
 //                                                   (mode 0600, directory 0700), and RUN_DIR/roster
 //                                                   with their public keys and the channels of each role
+//   masa_roster make RUN_DIR --keys DIR ...          the private keys (and their .pub) in DIR instead, a
+//                                                   directory on this host's own disk: a run directory on
+//                                                   a file system every host mounts then holds the roster
+//                                                   and no private key (issue #55, item 4)
 //   masa_roster show ROSTER                          the senders, their key fingerprints and channels
 // make keeps what is there: a resumed run keeps its keys, and more actors get keys of their own. It
 // keeps only what it wrote (issue #55, item 4): every line of an existing roster must carry the
@@ -80,8 +84,9 @@ void refuseEntriesNotOurs(const transport::Roster& roster, const fs::path& keys)
   }
 }
 
-int make(const std::string& dir, int actors, bool actors_given, bool runner, bool robot) {
-  const fs::path run(dir), keys = run / "keys", roster_path = run / "roster";
+int make(const std::string& dir, const std::string& keys_dir, int actors, bool actors_given, bool runner, bool robot) {
+  const fs::path run(dir), keys = keys_dir.empty() ? run / "keys" : fs::path(keys_dir), roster_path = run / "roster";
+  fs::create_directories(run);
   fs::create_directories(keys);
   ::chmod(keys.c_str(), 0700);
   transport::Roster roster;
@@ -126,20 +131,22 @@ int main(int argc, char** argv) {
   CLI::App app{"masa_roster: a key per process and the roster of a signed run"};
   app.set_version_flag("--version", buildCommit());
   app.require_subcommand(1);
-  std::string dir, path;
+  std::string dir, path, keys_dir;
   int actors = 1;
   bool runner = false, robot = false;
   auto* make_cmd = app.add_subcommand("make", "make the keys and the roster of a run directory (keeps what is there)");
   make_cmd->add_option("run_dir", dir, "the run directory")->required();
   auto* actors_opt = make_cmd->add_option("--actors", actors, "actors of the run (keys actor0 .. actorK-1); actors beyond "
                                           "leave the roster")->check(CLI::Range(0, 1 << 20));
+  make_cmd->add_option("--keys", keys_dir, "where the private keys go (default RUN_DIR/keys): a directory on this host's "
+                       "own disk when RUN_DIR is on a file system other hosts mount; give the same one each time");
   make_cmd->add_flag("--runner", runner, "a key for the robot's policy runner (masa_deploy), on the robot command channel");
   make_cmd->add_flag("--robot", robot, "a key for the robot (masa_sim_robot --signing-key), on the robot state channel");
   auto* show_cmd = app.add_subcommand("show", "the senders of a roster");
   show_cmd->add_option("roster", path, "a roster file")->required();
   CLI11_PARSE(app, argc, argv);
   try {
-    if (*make_cmd) return make(dir, actors, actors_opt->count() > 0, runner, robot);
+    if (*make_cmd) return make(dir, keys_dir, actors, actors_opt->count() > 0, runner, robot);
     return show(path);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_roster: %s\n", e.what());
