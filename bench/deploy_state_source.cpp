@@ -5,10 +5,13 @@
 // before it publishes; one clock, as both run on this machine): state published -> command
 // stamped (LCM's delivery and the runner's wakeups, observation, inference) and command stamped ->
 // received (the runner's publish, the delivery back and this program's wakeups). Prints p50 / p99
-// / max and the command count. A plain program.
+// / max and the command count. With --roster and --signing-key it is the robot of a signed run: it
+// signs its states with the robot's key and takes only commands the runner's key signed (the
+// default deployment, issue #55). A plain program.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cstdio>
 #include <thread>
 #include <vector>
@@ -30,7 +33,14 @@ int main(int argc, char** argv) {
   app.add_option("--policy", policy_path)->capture_default_str();
   app.add_option("--rate-hz", rate_hz)->capture_default_str();
   app.add_option("--seconds", seconds)->capture_default_str();
+  std::string roster_file, signing_key;
+  app.add_option("--roster", roster_file, "a signed robot: the roster (masa_roster make DIR --runner --robot)");
+  app.add_option("--signing-key", signing_key, "the robot's private key file, with --roster");
   CLI11_PARSE(app, argc, argv);
+  if (roster_file.empty() != signing_key.empty()) {
+    std::fprintf(stderr, "deploy_state_source: --roster and --signing-key go together\n");
+    return 2;
+  }
   policy::LoadedPolicy lp = policy::loadPolicyFile(policy_path);
   task::TaskFactory factory(task::taskCatalog(), lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source);
   auto sim = factory.create();
@@ -52,7 +62,10 @@ int main(int argc, char** argv) {
   s.base_x = q[0], s.base_y = q[1], s.base_z = q[2];
   s.base_qw = q[3], s.base_qx = q[4], s.base_qy = q[5], s.base_qz = q[6];
 
-  transport::Transport lcm("");
+  auto link = roster_file.empty() ? std::make_unique<transport::Transport>("")
+                                  : std::make_unique<transport::Transport>(
+                                        "", transport::loadSignedMode(roster_file, signing_key, {transport::Role::kRobot, 0}));
+  transport::Transport& lcm = *link;
   std::vector<int64_t> rtt, there, back;
   rtt.reserve(1 << 20);
   there.reserve(1 << 20);

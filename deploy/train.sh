@@ -13,7 +13,8 @@
 # FILE has one host per line, "host [actors] [envs]" (default 1 actor of E environments), '#'
 # comments; "localhost" runs its actors here without ssh. See deploy/hosts.example.
 # Every message is signed (--auth signed, the default): each process has its own Ed25519 key,
-# RUN_DIR/keys/<role><index>.key (mode 0600), and RUN_DIR/roster says whose key may publish on which
+# RUN_DIR/keys/<role><index>.key (mode 0600; MASA_KEYS_DIR puts them elsewhere, on this host's own
+# disk when RUN_DIR is on a file system other hosts mount), and RUN_DIR/roster says whose key may publish on which
 # channel (the learner's alone on MASA_POLICY, each actor's on its own rollouts and heartbeats), so a
 # stolen actor key can neither forge parameters nor another actor's rollouts; both are made here by
 # masa_roster before anything starts, kept on --resume (where the actors beyond --actors K leave the
@@ -219,14 +220,20 @@ elif [ "$auth_mode" = hmac ]; then
   bash deploy/run_key.sh "$run_dir/run.key"
   auth=(--key-file "$run_dir/run.key")
 else
-  "$build/tools/masa_roster" make "$run_dir" --actors "$actors" > /dev/null ||
-    { echo "train.sh: cannot make the keys and roster in $run_dir" >&2; exit 2; }
-  auth=(--roster "$run_dir/roster" --signing-key "$run_dir/keys/learner0.key")
+  # MASA_KEYS_DIR: the private keys on this host's own disk, when the run directory is on a file
+  # system other hosts mount (else every host could read the learner's key there).
+  keys_dir=${MASA_KEYS_DIR:-$run_dir/keys}
+  "$build/tools/masa_roster" make "$run_dir" --keys "$keys_dir" --actors "$actors" > /dev/null ||
+    { echo "train.sh: cannot make the keys and roster in $run_dir (keys in $keys_dir)" >&2; exit 2; }
+  auth=(--roster "$run_dir/roster" --signing-key "$keys_dir/learner0.key")
 fi
-# The options that give actor $1 its key.
+# The options that give actor $1 on host $2 (default here) its key: here, in the keys directory;
+# another host, the copy carried to its run directory (below).
 actor_auth() {
   if [ "$auth_mode" = signed ]; then
-    actor_auth_args=(--roster "$run_dir/roster" --signing-key "$run_dir/keys/actor$1.key")
+    local key="$run_dir/keys/actor$1.key"
+    [ "${2:-localhost}" = localhost ] && key="$keys_dir/actor$1.key"
+    actor_auth_args=(--roster "$run_dir/roster" --signing-key "$key")
   else
     actor_auth_args=("${auth[@]}")
   fi
@@ -290,18 +297,18 @@ remote_path() {  # a path under the run dir as the host sees it (relative: under
   [[ $1 = /* ]] && echo "$1" || echo "$remote_dir/$1"
 }
 if [ "$auth_mode" = signed ]; then
-  carry_file() {  # host, file under run_dir, umask
+  carry_file() {  # host, file here, its path under run_dir there, umask
     local q
-    q=$(printf %q "$run_dir/$2")
-    "${remote_shell[@]}" "$1" "cd $(printf %q "$remote_dir") && umask $3 && mkdir -p $(printf %q "$run_dir/keys") && cat > $q.tmp.\$\$ && mv -f $q.tmp.\$\$ $q" \
-      < "$run_dir/$2" || { echo "train.sh: cannot carry $2 to $1 (to $(remote_path "$run_dir/$2") there)" >&2; exit 2; }
+    q=$(printf %q "$run_dir/$3")
+    "${remote_shell[@]}" "$1" "cd $(printf %q "$remote_dir") && umask $4 && mkdir -p $(printf %q "$run_dir/keys") && cat > $q.tmp.\$\$ && mv -f $q.tmp.\$\$ $q" \
+      < "$2" || { echo "train.sh: cannot carry $3 to $1 (to $(remote_path "$run_dir/$3") there)" >&2; exit 2; }
   }
   a=0
   for i in "${!hosts[@]}"; do
     h=${hosts[i]}
     if [ "$h" != localhost ]; then
-      carry_file "$h" roster 077
-      for ((k = 0; k < host_actors[i]; ++k)); do carry_file "$h" "keys/actor$((a + k)).key" 077; done
+      carry_file "$h" "$run_dir/roster" roster 077
+      for ((k = 0; k < host_actors[i]; ++k)); do carry_file "$h" "$keys_dir/actor$((a + k)).key" "keys/actor$((a + k)).key" 077; done
     fi
     a=$((a + host_actors[i]))
   done
@@ -328,7 +335,7 @@ for i in "${!hosts[@]}"; do
     # localhost: this repository and build; another host: MASA_REMOTE_DIR and MASA_REMOTE_BUILD_DIR there.
     dir=$remote_dir bin_dir=$remote_build
     [ "$h" = localhost ] && dir=$PWD bin_dir=$build
-    actor_auth "$a"
+    actor_auth "$a" "$h"
     actor_cmd=("$bin_dir/actors/masa_actor" "${common[@]}" --url "$url" --run-id "$run_id" "${actor_auth_args[@]}" --actor-id "$a"
                --num-envs "${host_envs[i]}")
     cmd="cd $(printf %q "$dir") && exec env OMP_NUM_THREADS=1 bash deploy/tethered.sh $(printf '%q ' "${actor_cmd[@]}")"

@@ -3,8 +3,15 @@
 //                                                   a key per process, RUN_DIR/keys/<role><index>.key
 //                                                   (mode 0600, directory 0700), and RUN_DIR/roster
 //                                                   with their public keys and the channels of each role
+//   masa_roster make RUN_DIR --keys DIR ...          the private keys (and their .pub) in DIR instead, a
+//                                                   directory on this host's own disk: a run directory on
+//                                                   a file system every host mounts then holds the roster
+//                                                   and no private key (issue #55, item 4)
 //   masa_roster show ROSTER                          the senders, their key fingerprints and channels
-// make keeps what is there: a resumed run keeps its keys, and more actors get keys of their own.
+// make keeps what is there: a resumed run keeps its keys, and more actors get keys of their own. It
+// keeps only what it wrote (issue #55, item 4): every line of an existing roster must carry the
+// public key of RUN_DIR/keys/<role><index>.key and its role's channels; a line no key file of ours
+// backs (one someone planted, or a key swapped) is refused with the line named, never adopted.
 // With --actors given, actors beyond K leave the roster, their key files removed (issue #55, item 3): a run resumed with
 // fewer actors must not go on believing the ones it no longer runs, whose hosts still hold their
 // keys and whose recorded chunks would verify as current data. Brought back later, an actor index
@@ -53,12 +60,42 @@ int retireActorsFrom(transport::Roster& roster, int actors, const fs::path& keys
   return static_cast<int>(retired.size());
 }
 
-int make(const std::string& dir, int actors, bool actors_given, bool runner, bool robot) {
-  const fs::path run(dir), keys = run / "keys", roster_path = run / "roster";
+std::string keyStem(const fs::path& keys, transport::SenderId id) {
+  return (keys / (std::string(transport::roleName(id.role)) + std::to_string(id.index))).string();
+}
+
+// Throws unless every entry is one make wrote: its private key file is here, checked as any key
+// (owner, mode, directory), it gives the entry's public key, and the entry has its role's channels.
+void refuseEntriesNotOurs(const transport::Roster& roster, const fs::path& keys) {
+  for (const transport::Roster::Entry& e : roster.entries()) {
+    const std::string key_path = keyStem(keys, e.id) + ".key";
+    const std::string planted = "roster " + roster.source() + ": the line of " + e.id.name() + " (" +
+                                integrity::keyFingerprint(e.key) + ") is not one masa_roster wrote: ";
+    const std::string advice = "; a roster line masa_roster did not write is never adopted (remove the line, or the "
+                               "roster and keys to start afresh)";
+    if (!fs::exists(key_path)) throw std::runtime_error(planted + "there is no private key " + key_path + advice);
+    const integrity::SigningKey key = integrity::SigningKey::load(key_path);
+    if (key.publicKey() != e.key)
+      throw std::runtime_error(planted + "its key is not the one of " + key_path + " (" +
+                               integrity::keyFingerprint(key.publicKey()) + ")" + advice);
+    if (e.channels != transport::defaultChannels(e.id.role))
+      throw std::runtime_error(planted + "its channels are not those masa_roster gives " +
+                               std::string(transport::roleName(e.id.role)) + "s" + advice);
+  }
+}
+
+int make(const std::string& dir, const std::string& keys_dir, int actors, bool actors_given, bool runner, bool robot) {
+  const fs::path run(dir), keys = keys_dir.empty() ? run / "keys" : fs::path(keys_dir), roster_path = run / "roster";
+  fs::create_directories(run);
   fs::create_directories(keys);
   ::chmod(keys.c_str(), 0700);
   transport::Roster roster;
   if (fs::exists(roster_path)) roster = transport::Roster::load(roster_path.string());
+  {
+    // What stays is checked before anything is removed: a refused roster leaves the keys as they were.
+    std::vector<transport::SenderId> leaving;
+    refuseEntriesNotOurs(actors_given ? roster.withoutActorsFrom(static_cast<uint32_t>(actors), leaving) : roster, keys);
+  }
   const int retired = actors_given ? retireActorsFrom(roster, actors, keys) : 0;
   std::vector<transport::SenderId> wanted = {{transport::Role::kLearner, 0}};
   for (int a = 0; a < actors; ++a) wanted.push_back({transport::Role::kActor, static_cast<uint32_t>(a)});
@@ -67,7 +104,7 @@ int make(const std::string& dir, int actors, bool actors_given, bool runner, boo
   int made = 0;
   for (const transport::SenderId& id : wanted) {
     if (roster.find(id)) continue;
-    const std::string stem = (keys / (std::string(transport::roleName(id.role)) + std::to_string(id.index))).string();
+    const std::string stem = keyStem(keys, id);
     const integrity::PublicKeyBytes key = integrity::generateKeyPair(stem + ".key", stem + ".pub");
     roster.add(id, key, transport::defaultChannels(id.role));
     ++made;
@@ -94,20 +131,22 @@ int main(int argc, char** argv) {
   CLI::App app{"masa_roster: a key per process and the roster of a signed run"};
   app.set_version_flag("--version", buildCommit());
   app.require_subcommand(1);
-  std::string dir, path;
+  std::string dir, path, keys_dir;
   int actors = 1;
   bool runner = false, robot = false;
   auto* make_cmd = app.add_subcommand("make", "make the keys and the roster of a run directory (keeps what is there)");
   make_cmd->add_option("run_dir", dir, "the run directory")->required();
   auto* actors_opt = make_cmd->add_option("--actors", actors, "actors of the run (keys actor0 .. actorK-1); actors beyond "
                                           "leave the roster")->check(CLI::Range(0, 1 << 20));
+  make_cmd->add_option("--keys", keys_dir, "where the private keys go (default RUN_DIR/keys): a directory on this host's "
+                       "own disk when RUN_DIR is on a file system other hosts mount; give the same one each time");
   make_cmd->add_flag("--runner", runner, "a key for the robot's policy runner (masa_deploy), on the robot command channel");
   make_cmd->add_flag("--robot", robot, "a key for the robot (masa_sim_robot --signing-key), on the robot state channel");
   auto* show_cmd = app.add_subcommand("show", "the senders of a roster");
   show_cmd->add_option("roster", path, "a roster file")->required();
   CLI11_PARSE(app, argc, argv);
   try {
-    if (*make_cmd) return make(dir, actors, actors_opt->count() > 0, runner, robot);
+    if (*make_cmd) return make(dir, keys_dir, actors, actors_opt->count() > 0, runner, robot);
     return show(path);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_roster: %s\n", e.what());

@@ -6,7 +6,9 @@
 // Keys are Ed25519 PEM files (OpenSSL); a private key file is made with mode 0600 and refused when
 // others may read it. Keys go as files, never on the command line.
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -82,6 +84,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::vector<std::string> files;
   std::string trusted, private_path, public_path, key_path, target;
+  std::uint64_t release_version = 0;
 
   auto* check_cmd = app.add_subcommand("check", "check each file's seal (and signer)");
   check_cmd->add_option("files", files, "masa files")->required();
@@ -94,6 +97,8 @@ int main(int argc, char** argv) {
   auto* sign_cmd = app.add_subcommand("sign", "sign a sealed file with a private key");
   sign_cmd->add_option("file", target, "a sealed masa file (a policy)")->required()->check(CLI::ExistingFile);
   sign_cmd->add_option("--key", key_path, "the private key file")->required()->check(CLI::ExistingFile);
+  sign_cmd->add_option("--release-version", release_version, "sign as this release (1 and up), with the time: "
+                       "masa_deploy --min-policy-version refuses older ones")->check(CLI::Range(std::uint64_t{1}, UINT64_MAX));
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -106,8 +111,11 @@ int main(int argc, char** argv) {
       return 0;
     }
     const integrity::SigningKey key = integrity::SigningKey::load(key_path);
-    integrity::signSealedFile(target, key);
-    std::printf("%s: signed by %s\n", target.c_str(), integrity::keyFingerprint(key.publicKey()).c_str());
+    std::optional<integrity::SignedRelease> release;
+    if (release_version > 0) release = integrity::SignedRelease{release_version, static_cast<std::int64_t>(std::time(nullptr))};
+    integrity::signSealedFile(target, key, release);
+    std::printf("%s: signed by %s%s\n", target.c_str(), integrity::keyFingerprint(key.publicKey()).c_str(),
+                release ? (" as release " + std::to_string(release_version)).c_str() : "");
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "masa_seal: %s\n", e.what());

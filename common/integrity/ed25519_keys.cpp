@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "common/integrity/owned_file.hpp"
 #include "common/integrity/sha256.hpp"
 
 namespace masa::integrity {
@@ -70,11 +71,10 @@ std::string keyFingerprint(const PublicKeyBytes& key) {
 SigningKey::SigningKey(std::shared_ptr<Pkey> key) : key_(std::move(key)) { public_ = rawPublicKey(key_->key, "signing key"); }
 
 SigningKey SigningKey::load(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw std::runtime_error(path + ": no such private key file");
-  if (st.st_mode & 077)
-    throw std::runtime_error(path + ": a private key readable by others than its owner is refused (chmod 600 " + path + ")");
-  Bio bio(BIO_new_file(path.c_str(), "r"), &BIO_free);
+  if (!fs::exists(path)) throw std::runtime_error(path + ": no such private key file");
+  // Opened once, owner, mode and directory checked on the open file (owned_file.hpp).
+  const std::string pem = readOwnedFile(path, "private key", FileSecrecy::kSecret);
+  Bio bio(BIO_new_mem_buf(pem.data(), static_cast<int>(pem.size())), &BIO_free);
   if (!bio) throw std::runtime_error(path + ": cannot open the private key");
   auto pkey = std::make_shared<Pkey>();
   pkey->key = PEM_read_bio_PrivateKey(bio.get(), nullptr, nullptr, nullptr);

@@ -22,7 +22,8 @@ std::string keyFingerprint(const PublicKeyBytes& key);
 class SigningKey {
  public:
   // Reads a PEM private key; throws std::runtime_error naming the file when it is missing, not an
-  // Ed25519 key, or readable by others than its owner.
+  // Ed25519 key, readable by others than its owner, owned by another user, or in a directory
+  // another user owns or others may write (readOwnedFile, owned_file.hpp).
   static SigningKey load(const std::string& path);
   // A new key that lives only in this process's memory (an MPI job's processes: nothing to carry).
   static SigningKey generate();

@@ -25,6 +25,9 @@ constexpr std::size_t kHeaderBytes = 8 + 4 + 8 + 32;
 constexpr std::string_view kSignatureMagic = "MASASIG1";
 constexpr std::size_t kSignatureBytes = 8 + 32 + 64;
 constexpr std::string_view kSignatureContext = "masa sealed file signature 1\n";
+constexpr std::string_view kReleaseSignatureMagic = "MASASIG2";
+constexpr std::size_t kReleaseSignatureBytes = 8 + 32 + 8 + 8 + 64;
+constexpr std::string_view kReleaseSignatureContext = "masa sealed file signature 2\n";
 constexpr std::uint32_t kMaxKindBytes = 64;
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 34;  // 16 GiB: larger is not a masa file
 
@@ -45,12 +48,20 @@ struct Envelope {
   std::string kind;
   std::size_t payload_offset = 0, payload_size = 0, body_end = 0;
   std::optional<PublicKeyBytes> signer;
+  std::optional<SignedRelease> release;
 };
 
 [[noreturn]] void refuse(const std::string& name, const std::string& why) { throw std::runtime_error(name + ": " + why); }
 
 std::string signedMessage(const std::string& bytes) {
   return std::string(kSignatureContext).append(bytes, 0, kHeaderBytes);
+}
+
+std::string releaseSignedMessage(const std::string& bytes, const SignedRelease& release) {
+  std::string out(kReleaseSignatureContext);
+  appendPod(out, release.version);
+  appendPod(out, release.signed_unix_s);
+  return out.append(bytes, 0, kHeaderBytes);
 }
 
 // Checks the envelope: lengths against the file size, the body's SHA-256, the kind's bounds, and a
@@ -64,11 +75,13 @@ Envelope checkEnvelope(const std::string& bytes, const std::string& name) {
                      " (a newer masa's file, or a damaged one)");
   const auto body = podAt<std::uint64_t>(bytes, 12);
   const std::size_t after_header = bytes.size() - kHeaderBytes;
-  bool has_signature = false;
+  bool has_signature = false, has_release = false;
   if (body == after_header) {
     has_signature = false;
   } else if (after_header >= kSignatureBytes && body == after_header - kSignatureBytes) {
     has_signature = true;
+  } else if (after_header >= kReleaseSignatureBytes && body == after_header - kReleaseSignatureBytes) {
+    has_release = true;
   } else {
     refuse(name, "checksum mismatch (file corrupted or truncated: the seal holds " + std::to_string(body) + " bytes, the file " +
                      std::to_string(after_header) + ")");
@@ -95,6 +108,21 @@ Envelope checkEnvelope(const std::string& bytes, const std::string& name) {
     if (!verifySignature(key, signedMessage(bytes), sig))
       refuse(name, "signature does not verify (file corrupted or tampered with; key " + keyFingerprint(key) + ")");
     e.signer = key;
+  }
+  if (has_release) {
+    const std::size_t at = e.body_end;
+    if (bytes.compare(at, kReleaseSignatureMagic.size(), kReleaseSignatureMagic) != 0) refuse(name, "damaged signature block");
+    PublicKeyBytes key;
+    SignatureBytes sig;
+    SignedRelease release;
+    std::memcpy(key.data(), bytes.data() + at + 8, key.size());
+    release.version = podAt<std::uint64_t>(bytes, at + 8 + key.size());
+    release.signed_unix_s = podAt<std::int64_t>(bytes, at + 8 + key.size() + 8);
+    std::memcpy(sig.data(), bytes.data() + at + 8 + key.size() + 16, sig.size());
+    if (!verifySignature(key, releaseSignedMessage(bytes, release), sig))
+      refuse(name, "signature does not verify (file corrupted or tampered with; key " + keyFingerprint(key) + ")");
+    e.signer = key;
+    e.release = release;
   }
   return e;
 }
@@ -219,7 +247,10 @@ class HashingFileBuf final : public std::streambuf {
 
 std::string OpenedFile::describe() const {
   if (!sealed) return "unsealed (written before masa sealed its files: not checked)";
-  return signer ? "sealed (SHA-256 checked), signed by " + keyFingerprint(*signer) : "sealed (SHA-256 checked), unsigned";
+  if (!signer) return "sealed (SHA-256 checked), unsigned";
+  std::string out = "sealed (SHA-256 checked), signed by " + keyFingerprint(*signer);
+  if (release) out += " as release " + std::to_string(release->version);
+  return out;
 }
 
 std::string sealBytes(const FileKind& kind, std::string_view payload) {
@@ -276,8 +307,17 @@ OpenedFile openSealedBytes(std::string bytes, const std::string& name, const Fil
     if (!rules.require_signed_by->contains(*e.signer))
       refuse(name, "signed by " + keyFingerprint(*e.signer) + ", which is not a trusted key (" + rules.require_signed_by->source() + ")");
   }
+  if (rules.min_release_version > 0) {
+    // A release version is believed only as signed by a trusted key: anyone can sign their own.
+    if (!rules.require_signed_by) refuse(name, "a minimum release version needs the trusted keys that sign releases");
+    const std::string wanted = "release " + std::to_string(rules.min_release_version) + " or newer is required";
+    if (!e.release) refuse(name, "its signature names no release version, and " + wanted + " (masa_seal sign --release-version)");
+    if (e.release->version < rules.min_release_version)
+      refuse(name, "release " + std::to_string(e.release->version) + ", older than the newest accepted: " + wanted);
+  }
   out.sealed = true;
   out.signer = e.signer;
+  out.release = e.release;
   out.payload = bytes.substr(e.payload_offset, e.payload_size);
   return out;
 }
@@ -305,16 +345,20 @@ bool looksLikeKind(const std::string& path, const FileKind& kind) {
   return in && !kind.legacy_magic.empty() && head == kind.legacy_magic;
 }
 
-void signSealedFile(const std::string& path, const SigningKey& key) {
+void signSealedFile(const std::string& path, const SigningKey& key, const std::optional<SignedRelease>& release) {
   std::string bytes = readWholeFile(path);
   if (std::string_view(bytes).substr(0, kSealMagic.size()) != kSealMagic)
     refuse(path, "not sealed, so it cannot be signed (masa_seal add seals it)");
   const Envelope e = checkEnvelope(bytes, path);
   bytes.resize(e.body_end);  // any earlier signature goes
-  const SignatureBytes sig = key.sign(signedMessage(bytes));
+  const SignatureBytes sig = key.sign(release ? releaseSignedMessage(bytes, *release) : signedMessage(bytes));
   const PublicKeyBytes pub = key.publicKey();
-  bytes.append(kSignatureMagic);
+  bytes.append(release ? kReleaseSignatureMagic : kSignatureMagic);
   bytes.append(reinterpret_cast<const char*>(pub.data()), pub.size());
+  if (release) {
+    appendPod(bytes, release->version);
+    appendPod(bytes, release->signed_unix_s);
+  }
   bytes.append(reinterpret_cast<const char*>(sig.data()), sig.size());
   writeAtomically(path, bytes);
 }

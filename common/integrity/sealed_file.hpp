@@ -8,7 +8,13 @@
 //   "MASASEAL" | u32 envelope version (1) | u64 body length | 32-byte SHA-256 of the body |
 //   body: u32 kind length, kind ("masa policy", ...), payload |
 //   optional signature: "MASASIG1" | 32-byte Ed25519 public key | 64-byte signature of
-//                       "masa sealed file signature 1\n" + the 52 bytes before the body.
+//                       "masa sealed file signature 1\n" + the 52 bytes before the body,
+//   or a release's:     "MASASIG2" | 32-byte public key | u64 release version | i64 signing time
+//                       (Unix seconds) | 64-byte signature of "masa sealed file signature 2\n" +
+//                       version + time + the 52 bytes before the body.
+// The 52 bytes hold the body's SHA-256, so a signature covers the whole content (a policy's task,
+// method and model); a release's also its version and time, so a reader can refuse an older
+// release signed by the same trusted key (issue #55, item 4).
 // The kind says what the payload is, so that one kind of file is never read as another.
 //
 // Files written before the seal (their payload alone, starting with the format's own magic) are
@@ -17,6 +23,7 @@
 // payload.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <iosfwd>
 #include <optional>
@@ -32,9 +39,17 @@ struct FileKind {
   std::string_view legacy_magic;  // how the payload begins, which is how an unsealed file began
 };
 
+// A release's version and signing time, covered by its signature.
+struct SignedRelease {
+  std::uint64_t version = 0;
+  std::int64_t signed_unix_s = 0;
+};
+
 // What a reader requires beyond an intact file.
 struct ReadRules {
   const TrustedKeys* require_signed_by = nullptr;  // refuse a file not signed by one of these keys
+  // Above 0 (with require_signed_by): refuse a file whose signature names no release or an older one.
+  std::uint64_t min_release_version = 0;
   bool warn_unsealed = true;                       // the one-line warning for a file from before the seal
 };
 
@@ -42,6 +57,7 @@ struct OpenedFile {
   std::string payload;
   bool sealed = false;                   // false: a file from before the seal (warned about)
   std::optional<PublicKeyBytes> signer;  // the key whose signature verified
+  std::optional<SignedRelease> release;  // what that signature says of the release, when it does
   std::string describe() const;          // "sealed (SHA-256 checked), signed by ed25519:..." and the like
 };
 
@@ -68,7 +84,7 @@ bool looksLikeKind(const std::string& path, const FileKind& kind);
 std::string sealedKindOf(const std::string& path);
 
 // Signs a sealed file in place (atomically), replacing any signature it had; the file's seal is
-// checked first, whatever its kind.
-void signSealedFile(const std::string& path, const SigningKey& key);
+// checked first, whatever its kind. With `release`, the signature covers its version and time too.
+void signSealedFile(const std::string& path, const SigningKey& key, const std::optional<SignedRelease>& release = std::nullopt);
 
 }  // namespace masa::integrity

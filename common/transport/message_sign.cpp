@@ -62,6 +62,10 @@ bool verifyWith(void* pkey, const uint8_t* signed_bytes, const uint8_t* signatur
 
 }  // namespace
 
+int64_t maxSignedMessageBytes(Role role) {
+  return role == Role::kRobot || role == Role::kRunner ? int64_t{64} << 10 : int64_t{64} << 20;
+}
+
 MessageSigner::MessageSigner(integrity::SigningKey key, SenderId id, uint64_t first_counter)
     : key_(std::move(key)),
       public_(key_.publicKey()),
@@ -145,6 +149,11 @@ OpenedMessage MessageVerifier::open(std::string_view channel, const void* data, 
     return m;
   }
   const int message_size = size - kSigTrailerBytes;
+  if (message_size > maxSignedMessageBytes(m.sender.role)) {
+    m.verdict = WireVerdict::kOverLimit;
+    return m;
+  }
+  ++messages_hashed_;
   uint8_t to_check[kSignedBytes];
   signedBytes(channel, trailer, p, message_size, to_check);
   if (!verifyWith(entry->verifier.get(), to_check, trailer + kSigHeaderBytes)) {

@@ -11,6 +11,8 @@
 //   - a SIG1 trailer is there, with a role byte of a role ........................ unauthenticated
 //   - the roster lists the sender (role, index) ................................... unknown_sender
 //   - the roster lets that sender publish on this channel ......................... not_permitted
+//   - the message is no longer than its sender's role sends (maxSignedMessageBytes) . over_limit
+//     (before any byte is hashed: a forged message of many megabytes costs a lookup, not a hash)
 //   - the signature verifies under the roster's key for that sender ................ unauthenticated
 //   - what the message claims to be from matches the signer (Transport: an actor's chunks and
 //     heartbeats name its own actor id) .............................................. claims_another_sender
@@ -45,6 +47,11 @@ inline constexpr int kSigMarkerBytes = 4;
 inline constexpr int kSigHeaderBytes = kSigMarkerBytes + 1 + 4 + 8;  // marker, role, index, counter
 inline constexpr int kSigBytes = 64;
 inline constexpr int kSigTrailerBytes = kSigHeaderBytes + kSigBytes;  // 81
+// The longest message (before its trailer) a sender of `role` may sign: a robot's state and a
+// runner's command are a few hundred bytes a joint (64 KiB: over 1500 joints), a learner's policy
+// and an actor's chunk far below 64 MiB.
+int64_t maxSignedMessageBytes(Role role);
+
 // How far below the highest counter seen from a sender on a channel a message may still arrive
 // (reordered by the network) and be taken once.
 inline constexpr int kReplayWindow = 1024;
@@ -113,9 +120,12 @@ class MessageVerifier {
   // Moves the window: for a message every check passed.
   void accept(std::string_view channel, const OpenedMessage& m);
   const Roster& roster() const { return *roster_; }
+  // How many messages open() hashed to check their signature: what a forged message cost.
+  int64_t messagesHashed() const { return messages_hashed_; }
 
  private:
   std::shared_ptr<const Roster> roster_;
+  mutable int64_t messages_hashed_ = 0;
   uint64_t not_before_us_;
   std::map<std::pair<SenderId, std::string>, ReplayWindow> windows_;
 };

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
 #include <openssl/evp.h>
-#include <sys/stat.h>
 
+#include "common/integrity/owned_file.hpp"
 #include "common/transport/channels.hpp"
 
 namespace masa::transport {
@@ -158,19 +158,14 @@ Roster Roster::parse(std::string_view text, const std::string& source) {
 }
 
 Roster Roster::load(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw rosterError(path, 0, "cannot read it (make one with masa_roster)");
-  if ((st.st_mode & 022) != 0) {
-    char mode[8];
-    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
-    throw rosterError(path, 0, std::string("others may write it (mode ") + mode +
-                                   "), so anyone could add a key that is then believed (chmod go-w " + path + ")");
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw rosterError(path, 0, "cannot read it (make one with masa_roster)");
+  try {
+    return parse(integrity::readOwnedFile(path, "roster", integrity::FileSecrecy::kPublic), path);
+  } catch (const std::runtime_error& e) {
+    if (std::string_view(e.what()).starts_with("roster ")) throw;
+    throw rosterError(path, 0, e.what());
   }
-  std::ifstream f(path);
-  if (!f) throw rosterError(path, 0, "cannot read it");
-  std::ostringstream text;
-  text << f.rdbuf();
-  return parse(text.str(), path);
 }
 
 }  // namespace masa::transport

@@ -11,8 +11,9 @@
 //   actor 0   d75a9801...  MASA_ROLLOUT,MASA_ACTOR_HEARTBEAT
 //
 // made by masa_roster (tools/roster.cpp; deploy/train.sh runs it), public and carried to every
-// host beside the process's own private key. A roster others may write is refused: whoever writes
-// it decides who is believed.
+// host beside the process's own private key. Whoever writes it decides who is believed, so it is
+// read only when the user running masa (or root) owns it and its directory and nobody else may
+// write either, from the very file checked (integrity::readOwnedFile; issue #55, item 4).
 #pragma once
 
 #include <cstdint>
@@ -57,7 +58,8 @@ class Roster {
   };
 
   // Reads a roster file; throws std::runtime_error naming the file and line when it is missing,
-  // writable by others than its owner, or malformed (an unknown role, a key that is not 64 hex
+  // owned by another user, writable by others than its owner, in a directory others own or may
+  // write (integrity::readOwnedFile), or malformed (an unknown role, a key that is not 64 hex
   // digits, no channel, a sender twice).
   static Roster load(const std::string& path);
   static Roster parse(std::string_view text, const std::string& source);

@@ -28,7 +28,8 @@ enum class WireVerdict : int {
   kTruncated,       // a field, array or string runs past the end of the bytes
   kTrailingBytes,   // bytes left after the last field
   kNegativeLength,  // an array or string length below zero
-  kOverLimit,       // an array or string longer than WireLimits allows
+  kOverLimit,       // an array or string longer than WireLimits allows, or a signed message longer than
+                    // its sender's role sends (maxSignedMessageBytes, message_sign.hpp), refused unhashed
   kBadString,       // a string without its terminating NUL, with a NUL inside, or of length 0
   kDecodeFailed,    // the guard passed but lcm-gen's decoder did not consume exactly the bytes
   kUnauthenticated, // no trailer of the run key that verifies (Transport with a key, message_auth.hpp), or

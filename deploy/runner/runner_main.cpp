@@ -151,6 +151,7 @@ struct DeployArgs {
   std::vector<std::string> sets;
   double duration_s = 0;
   int64_t max_policy_steps = 0;
+  uint64_t min_policy_version = 0;
   bool quiet = false, exit_on_trip = false, require_signed = false, verify_state = false, insecure = false;
   std::string trusted_keys_path, roster_file, signing_key;
 };
@@ -171,6 +172,8 @@ int parseArgs(int argc, char** argv, DeployArgs& a) {
   app.add_flag("--exit-on-trip", a.exit_on_trip, "exit (code 4) once the watchdog or the emergency stop has tripped and its command is out");
   app.add_flag("--quiet", a.quiet, "no per-second status line");
   app.add_flag("--require-signed", a.require_signed, "refuse a policy file not signed by a key of --trusted-keys");
+  app.add_option("--min-policy-version", a.min_policy_version,
+                 "with --require-signed: refuse a policy not signed as this release or a newer one (masa_seal sign --release-version)");
   app.add_option("--trusted-keys", a.trusted_keys_path, "Ed25519 public key file (PEM), or a directory of *.pub files")
       ->check(CLI::ExistingPath);
   auto* roster_opt = app.add_option("--roster", a.roster_file,
@@ -201,6 +204,10 @@ int parseArgs(int argc, char** argv, DeployArgs& a) {
                                           : "masa_deploy: --trusted-keys is used with --require-signed (say both)\n");
     return 2;
   }
+  if (a.min_policy_version > 0 && !a.require_signed) {
+    std::fprintf(stderr, "masa_deploy: --min-policy-version needs --require-signed (a release version is believed only as a trusted key signed it)\n");
+    return 2;
+  }
   return -1;
 }
 
@@ -211,6 +218,7 @@ policy::LoadedPolicy loadCheckedPolicy(const DeployArgs& a) {
   if (a.require_signed) {
     trusted = integrity::TrustedKeys::load(a.trusted_keys_path);
     rules.require_signed_by = &trusted;
+    rules.min_release_version = a.min_policy_version;
   }
   policy::LoadedPolicy lp = policy::loadPolicyFile(a.policy_path, config::defaultConfigsDir(), rules);
   std::fprintf(stderr, "masa_deploy: %s: %s\n", a.policy_path.c_str(), lp.integrity.c_str());
