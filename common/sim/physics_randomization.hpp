@@ -1,8 +1,9 @@
 // Randomized physics for a task's episodes (issue #52): `env.randomization` in the task config, off
 // when absent (then nothing here runs and the task is bit for bit what it was). Each episode draws,
 // from the reset's seeded generator, scales of link masses (inertia alike), geom friction, joint
-// damping and friction loss, and actuator strength, a control latency, and an observation bias;
-// each step adds observation noise.
+// damping and friction loss, actuator strength and the task's PD gains, centre-of-mass offsets
+// (com_offsets.hpp), a control latency, and an observation bias; each step adds observation noise,
+// and may push the robot base (episode_pushes.hpp). The draws are in the episode's statistics.
 //
 // Symmetric by default: elements the robot's symmetry carries onto each other (the limbs' joints,
 // their bodies, those bodies' geoms, their actuators: the orbits of the spec's action permutation)
