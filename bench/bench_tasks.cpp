@@ -5,6 +5,9 @@
 // ended, from one seed. TaskStep runs Task::step + observe; PhysicsOnly runs Task::advancePhysics
 // (clamp, actuation, frame-skip mj_step substeps with the task's PD loop) on the same actions
 // with resets at the same steps, i.e. the same trajectory without the task's own work.
+// Randomized runs TaskStep with env.randomization on (issue #52: every key, a draw per episode),
+// against TaskStep for the cost of the randomization (target: >= 0.95 of TaskStep's rate):
+//   taskset -c 1 build/bench/bench_tasks --benchmark_filter='TaskStep/a1_beam|Randomized/a1_beam'
 //   taskset -c 1 build/bench/bench_tasks --benchmark_repetitions=5
 //       --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
@@ -29,8 +32,16 @@ struct Replay {
   std::vector<char> done;      // episode ended at this step: reset before the next
 };
 
-Replay record(const std::string& name) {
-  const auto rc = config::loadRunConfig(config::defaultConfigsDir(), {"task=" + name});
+// Every randomization key at once: what a sim-to-real run would draw (docs/randomization.md).
+const std::string kRandomization =
+    "env.randomization={mass_scale: [0.8, 1.2], geom_friction_scale: [0.5, 1.25], joint_damping_scale: [0.5, 1.5], "
+    "joint_friction_scale: [0.5, 1.5], actuator_strength: [0.85, 1.15], latency_steps: [0, 1.5], obs_noise_std: 0.01, "
+    "obs_bias: 0.02}";
+
+Replay record(const std::string& name, bool randomized) {
+  std::vector<std::string> sets = {"task=" + name};
+  if (randomized) sets.push_back(kRandomization);
+  const auto rc = config::loadRunConfig(config::defaultConfigsDir(), sets);
   Replay r{std::make_unique<task::TaskFactory>(task::taskCatalog(), rc.task, sym::SymmetrySpec::load(rc.spec_path), rc.env, rc.origin), {}, {}};
   auto env = r.factory->create();
   Rng act_rng(kSeed + 1), reset_rng(kSeed);
@@ -47,9 +58,9 @@ Replay record(const std::string& name) {
   return r;
 }
 
-template <bool kFullStep>
+template <bool kFullStep, bool kRandomized = false>
 void replay(benchmark::State& state, const std::string& name) {
-  const Replay r = record(name);
+  const Replay r = record(name, kRandomized);
   auto env = r.factory->create();
   std::vector<float> obs(env->obsDim());
   Rng reset_rng(kSeed);
@@ -89,6 +100,7 @@ int main(int argc, char** argv) {
   for (const std::string& name : names) {
     benchmark::RegisterBenchmark(("PhysicsOnly/" + name).c_str(), replay<false>, name);
     benchmark::RegisterBenchmark(("TaskStep/" + name).c_str(), replay<true>, name);
+    benchmark::RegisterBenchmark(("Randomized/" + name).c_str(), replay<true, true>, name);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -186,6 +186,7 @@ int main(int argc, char** argv) {
         std::printf("episode %zu (seed %llu): return %.3f, length %d, %s", k, static_cast<unsigned long long>(e.seed),
                     e.ret, e.length, e.terminated ? "terminated" : "time limit");
         for (size_t i = 0; i < e.progress.size(); ++i) std::printf(", %s %.3f", s.progress_names[i].c_str(), e.progress[i]);
+        for (size_t i = 0; i < e.physics.size(); ++i) std::printf(", %s %.3f", s.physics_names[i].c_str(), e.physics[i]);
         if (e.success >= 0) std::printf(", %s", e.success ? "success" : "no success");
         std::printf("\n");
       }

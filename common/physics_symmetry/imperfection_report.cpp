@@ -11,6 +11,11 @@ namespace masa::task {
 ImperfectionReport imperfectionReport(const TaskFactory& factory, const SymmetryVerifierOptions& options) {
   ImperfectionReport report;
   std::unique_ptr<Task> t = factory.create();
+  if (t->randomization()) {
+    // env.randomization: the model of an episode drawn from the seed (per_limb: limbs that differ).
+    Rng rng(options.seed);
+    t->reset(rng);
+  }
   const mjModel* m = t->model();
   const sym::SymmetrySpec& spec = t->spec();
   const int n = spec.numAgents(), cd = spec.actCentralDim(), ld = spec.actLimbDim();

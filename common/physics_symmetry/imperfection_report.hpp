@@ -27,6 +27,8 @@ struct ImperfectionReport {
   std::string summary(int top_k = 8) const;
 };
 
+// With env.randomization the model is that of an episode drawn from options.seed: per_limb draws
+// show as the limbs whose masses, damping, gear, ... differ.
 ImperfectionReport imperfectionReport(const TaskFactory& factory, const SymmetryVerifierOptions& options = {});
 
 }  // namespace masa::task

@@ -7,6 +7,8 @@
 #include <stdexcept>
 
 #include "common/core/config_error.hpp"
+#include "common/sim/com_offsets.hpp"
+#include "common/symmetry/group_element.hpp"
 
 namespace masa::task {
 namespace {
@@ -87,7 +89,9 @@ RandomizationConfig RandomizationConfig::read(EnvParams& params) {
   if (!section.IsMap()) throw ConfigError(params.origin("randomization"), "env.randomization", "expected a mapping");
   static const std::vector<std::string> known = {"per_limb",       "mass_scale",    "geom_friction_scale",
                                                  "joint_damping_scale", "joint_friction_scale", "actuator_strength",
-                                                 "latency_steps",  "obs_noise_std", "obs_bias"};
+                                                 "latency_steps",  "obs_noise_std", "obs_bias",
+                                                 "pd_kp_scale",    "pd_kd_scale",   "push_velocity", "push_interval_s",
+                                                 "com_offset"};
   for (const auto& kv : section) {
     const std::string key = kv.first.as<std::string>();
     if (std::find(known.begin(), known.end(), key) == known.end()) {
@@ -104,6 +108,8 @@ RandomizationConfig RandomizationConfig::read(EnvParams& params) {
   c.joint_damping = readScale(params, "randomization.joint_damping_scale");
   c.joint_friction = readScale(params, "randomization.joint_friction_scale");
   c.actuator_strength = readScale(params, "randomization.actuator_strength");
+  c.pd_kp = readScale(params, "randomization.pd_kp_scale");
+  c.pd_kd = readScale(params, "randomization.pd_kd_scale");
   // Latency: [min, max] steps, 0 allowed (a scale range read, then checked for >= 0 instead).
   const YAML::Node lat = params.section("randomization.latency_steps");
   if (lat.IsDefined() && !lat.IsNull()) {
@@ -134,6 +140,18 @@ RandomizationConfig RandomizationConfig::read(EnvParams& params) {
   if (c.obs_bias < 0.0)
     throw ConfigError(params.origin("randomization.obs_bias"), "env.randomization.obs_bias",
                       "cannot be negative, got " + std::to_string(c.obs_bias));
+  c.com_offset = params.number("randomization.com_offset", 0.0);
+  if (!(c.com_offset >= 0.0) || !std::isfinite(c.com_offset))
+    throw ConfigError(params.origin("randomization.com_offset"), "env.randomization.com_offset",
+                      "expected a finite distance >= 0 (metres), got " + std::to_string(c.com_offset));
+  c.push_velocity = params.number("randomization.push_velocity", 0.0);
+  c.push_interval_s = params.number("randomization.push_interval_s", 0.0);
+  if (!(c.push_velocity >= 0.0) || !std::isfinite(c.push_velocity))
+    throw ConfigError(params.origin("randomization.push_velocity"), "env.randomization.push_velocity",
+                      "expected a finite speed >= 0 (m/s), got " + std::to_string(c.push_velocity));
+  if (c.push_velocity > 0.0 && !(c.push_interval_s > 0.0 && std::isfinite(c.push_interval_s)))
+    throw ConfigError(params.origin("randomization.push_interval_s"), "env.randomization.push_interval_s",
+                      "pushes need a finite mean interval > 0 (seconds), got " + std::to_string(c.push_interval_s));
   return c;
 }
 
@@ -148,6 +166,7 @@ PhysicsRandomization::PhysicsRandomization(const RandomizationConfig& config, mj
   damping0_.assign(m->dof_damping, m->dof_damping + m->nv);
   frictionloss0_.assign(m->dof_frictionloss, m->dof_frictionloss + m->nv);
   gear0_.assign(m->actuator_gear, m->actuator_gear + 6 * m->nu);
+  ipos0_.assign(m->body_ipos, m->body_ipos + 3 * m->nbody);
 
   // The orbits: action r and the action T_i maps onto it drive joints (and actuators) the symmetry
   // carries onto each other, for every group element; their bodies, those bodies' geoms (in
@@ -206,14 +225,45 @@ PhysicsRandomization::PhysicsRandomization(const RandomizationConfig& config, mj
   }
   dof_orbit_.assign(static_cast<std::size_t>(m->nv), -1);
   for (int v = 0; v < m->nv; ++v) dof_orbit_[v] = joint_group[m->dof_jntid[v]];
+  // An action's PD gains follow its joint's orbit (an action without a joint: the first group).
+  action_group_.clear();
+  for (int j : action_joint) action_group_.push_back(j >= 0 ? joint_group[j] : 0);
 
   body_scale_.assign(static_cast<std::size_t>(n_body_groups_), 1.0);
   geom_scale_.assign(static_cast<std::size_t>(n_geom_groups_), 1.0);
   damping_scale_.assign(static_cast<std::size_t>(n_dof_groups_), 1.0);
   frictionloss_scale_.assign(static_cast<std::size_t>(n_dof_groups_), 1.0);
   actuator_scale_.assign(static_cast<std::size_t>(n_actuator_groups_), 1.0);
+  kp_scale_.assign(static_cast<std::size_t>(std::max(n_dof_groups_, 1)), 1.0);
+  kd_scale_.assign(static_cast<std::size_t>(std::max(n_dof_groups_, 1)), 1.0);
   obs_bias_.assign(static_cast<std::size_t>(obs_dim_), 0.0);
   scratch_ = mj_makeData(m_);
+
+  // For the centre-of-mass offsets: where T_i carries each body (the action map: the joint of
+  // column c moves to that of row r), the spatial maps S_i, the robot base, and each body's
+  // orientation at the reference pose (the offsets are drawn in the world frame there).
+  body_image_.assign(static_cast<std::size_t>(spec.numAgents()), std::vector<int>(static_cast<std::size_t>(m->nbody), -1));
+  for (int i = 0; i < spec.numAgents(); ++i) {
+    const sym::SparseMap& t = spec.actTransform(i);
+    for (int r = 0; r < t.rows(); ++r)
+      for (int p = t.rowStart()[r]; p < t.rowStart()[r + 1]; ++p) {
+        const int c = t.colIndex()[p];
+        if (action_joint[r] >= 0 && action_joint[c] >= 0)
+          body_image_[i][m->jnt_bodyid[action_joint[c]]] = m->jnt_bodyid[action_joint[r]];
+      }
+    const Eigen::Matrix3d s = sym::spatialMap(spec.group(), i);
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 3; ++col) spatial_map_.push_back(s(row, col));
+  }
+  for (const auto& fj : spec.mujoco().free_joints)
+    if (fj.kind == sym::FreeJointKind::kRobotBase) {
+      const int j = mj_name2id(m, mjOBJ_JOINT, fj.name.c_str());
+      if (j >= 0) base_body_ = m->jnt_bodyid[j];
+    }
+  mj_resetData(m, scratch_);
+  mj_kinematics(m, scratch_);
+  body_rot0_.assign(scratch_->xmat, scratch_->xmat + 9 * m->nbody);
+  com_offset_.assign(3 * static_cast<std::size_t>(m->nbody), 0.0);
 }
 
 void PhysicsRandomization::drawEpisode(Rng& rng) {
@@ -227,6 +277,9 @@ void PhysicsRandomization::drawEpisode(Rng& rng) {
   draw(config_.joint_damping, damping_scale_);
   draw(config_.joint_friction, frictionloss_scale_);
   draw(config_.actuator_strength, actuator_scale_);
+  draw(config_.pd_kp, kp_scale_);
+  draw(config_.pd_kd, kd_scale_);
+  if (config_.com_offset > 0.0) drawComOffsets(config_.com_offset, config_.per_limb, body_image_, spatial_map_, base_body_, rng, com_offset_);
   if (config_.latency_hi > 0.0) latency_ = std::uniform_real_distribution<double>(config_.latency_lo, config_.latency_hi)(rng);
   if (config_.obs_bias > 0.0) {
     std::uniform_real_distribution<double> u(-config_.obs_bias, config_.obs_bias);
@@ -250,6 +303,13 @@ void PhysicsRandomization::apply() {
   }
   for (int a = 0; a < m->nu; ++a)
     for (int k = 0; k < 6; ++k) m->actuator_gear[6 * a + k] = gear0_[6 * a + k] * actuator_scale_[actuator_orbit_[a]];
+  // The offset is drawn in the world frame at the reference pose: into each body's own frame (R^T d).
+  for (int b = 0; b < m->nbody; ++b)
+    for (int k = 0; k < 3; ++k) {
+      const double* rot = body_rot0_.data() + 9 * b;
+      const double* d = com_offset_.data() + 3 * b;
+      m->body_ipos[3 * b + k] = ipos0_[3 * b + k] + rot[k] * d[0] + rot[3 + k] * d[1] + rot[6 + k] * d[2];
+    }
   latency_steps_ = static_cast<int>(std::floor(latency_));
   // The derived quantities (body_subtreemass, the inverse weights at qpos0, ...) from the new masses.
   mj_setConst(m, scratch_);
@@ -260,26 +320,50 @@ PhysicsRandomization::~PhysicsRandomization() {
 }
 
 void PhysicsRandomization::save(std::vector<double>& out) const {
-  for (const auto* v : {&body_scale_, &geom_scale_, &damping_scale_, &frictionloss_scale_, &actuator_scale_, &obs_bias_})
+  for (const auto* v : {&body_scale_, &geom_scale_, &damping_scale_, &frictionloss_scale_, &actuator_scale_, &kp_scale_,
+                        &kd_scale_, &obs_bias_, &com_offset_})
     out.insert(out.end(), v->begin(), v->end());
   out.push_back(latency_);
 }
 
 std::size_t PhysicsRandomization::load(std::span<const double> in, const std::string& task_name) {
   std::size_t at = 0;
-  for (auto* v : {&body_scale_, &geom_scale_, &damping_scale_, &frictionloss_scale_, &actuator_scale_, &obs_bias_}) {
+  for (auto* v : {&body_scale_, &geom_scale_, &damping_scale_, &frictionloss_scale_, &actuator_scale_, &kp_scale_,
+                  &kd_scale_, &obs_bias_, &com_offset_}) {
     if (in.size() < at + v->size()) throw std::runtime_error("task state of " + task_name + ": the randomized physics is cut short");
     std::copy(in.begin() + static_cast<std::ptrdiff_t>(at), in.begin() + static_cast<std::ptrdiff_t>(at + v->size()), v->begin());
     at += v->size();
   }
   if (in.size() < at + 1) throw std::runtime_error("task state of " + task_name + ": the randomized physics is cut short");
   latency_ = in[at++];
-  for (const auto* v : {&body_scale_, &geom_scale_, &damping_scale_, &frictionloss_scale_, &actuator_scale_})
+  for (const auto* v : {&body_scale_, &geom_scale_, &damping_scale_, &frictionloss_scale_, &actuator_scale_, &kp_scale_,
+                        &kd_scale_})
     for (double x : *v)
       if (!(x > 0.0) || !std::isfinite(x)) throw std::runtime_error("task state of " + task_name + ": a randomized scale is not positive");
   if (!(latency_ >= 0.0 && latency_ <= 100.0)) throw std::runtime_error("task state of " + task_name + ": a bad latency");
   apply();
   return at;
+}
+
+const std::vector<std::string>& PhysicsRandomization::drawNames() {
+  static const std::vector<std::string> names = {
+      "physics: mass_scale",        "physics: geom_friction_scale", "physics: joint_damping_scale",
+      "physics: joint_friction_scale", "physics: actuator_strength", "physics: pd_kp_scale",
+      "physics: pd_kd_scale",       "physics: latency_steps"};
+  return names;
+}
+
+void PhysicsRandomization::summarize(std::vector<double>& out) const {
+  out.clear();
+  auto mean = [](const std::vector<double>& v) {
+    double sum = 0;
+    for (double x : v) sum += x;
+    return v.empty() ? 1.0 : sum / static_cast<double>(v.size());
+  };
+  for (const auto* v : {&body_scale_, &geom_scale_, &damping_scale_, &frictionloss_scale_, &actuator_scale_, &kp_scale_,
+                        &kd_scale_})
+    out.push_back(mean(*v));
+  out.push_back(latency_);
 }
 
 void PhysicsRandomization::perturbObservation(float* obs, int n, Rng& noise_rng) const {

@@ -55,6 +55,7 @@ EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook, con
   EvalSummary s;
   s.term_names = first.rewardTermNames();
   s.progress_names = first.progressNames();
+  s.physics_names = first.physicsDrawNames();
   s.episodes.resize(n);
   Vec<float> log_std(act_dim);
   model_->logStd(log_std);
@@ -108,6 +109,7 @@ EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook, con
       r.truncated = !st.terminated;  // the time limit, or max_steps
       r.success = st.has_success ? (st.success ? 1 : 0) : -1;
       r.terms = st.term_sums;
+      r.physics = st.physics;
       r.progress.assign(s.progress_names.size(), 0.0);
       if (!r.progress.empty()) env.progress(r.progress.data());
     }
@@ -124,6 +126,8 @@ EvalSummary PolicyEvaluator::run(const EvalOptions& o, const StepHook& hook, con
   for (size_t i = 0; i < s.term_names.size(); ++i) s.terms.push_back(gather([&](const EpisodeResult& r) { return r.terms[i]; }));
   for (size_t i = 0; i < s.progress_names.size(); ++i)
     s.progress.push_back(gather([&](const EpisodeResult& r) { return r.progress[i]; }));
+  for (size_t i = 0; i < s.physics_names.size(); ++i)
+    s.physics.push_back(gather([&](const EpisodeResult& r) { return r.physics[i]; }));
   int measured = 0, succeeded = 0;
   for (const EpisodeResult& r : s.episodes) {
     if (r.success >= 0) ++measured;
@@ -149,6 +153,7 @@ std::string formatSummary(const EvalSummary& s) {
   row("length (steps)", s.length);
   for (size_t i = 0; i < s.progress_names.size(); ++i) row(s.progress_names[i], s.progress[i]);
   for (size_t i = 0; i < s.term_names.size(); ++i) row("reward: " + s.term_names[i], s.terms[i]);
+  for (size_t i = 0; i < s.physics_names.size(); ++i) row(s.physics_names[i], s.physics[i]);
   std::snprintf(line, sizeof line, "time limit reached in %d of %d episodes", s.time_limit_reached, n);
   os << line;
   if (s.success_rate >= 0) {

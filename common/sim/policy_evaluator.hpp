@@ -30,6 +30,7 @@ struct EpisodeResult {
   bool terminated = false, truncated = false;
   int success = -1;  // -1: the task has no success notion
   std::vector<double> terms, progress;
+  std::vector<double> physics;  // env.randomization's draws (Task::physicsDrawNames())
 };
 
 struct Moments {
@@ -37,10 +38,10 @@ struct Moments {
 };
 
 struct EvalSummary {
-  std::vector<std::string> term_names, progress_names;
+  std::vector<std::string> term_names, progress_names, physics_names;
   std::vector<EpisodeResult> episodes;
   Moments ret, length;
-  std::vector<Moments> terms, progress;
+  std::vector<Moments> terms, progress, physics;
   double success_rate = -1;  // -1: the task has no success notion
   int time_limit_reached = 0;  // episodes that ran to the time limit (or max_steps)
 };

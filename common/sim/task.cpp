@@ -5,6 +5,8 @@
 #include <stdexcept>
 
 #include "common/core/check.hpp"
+#include "common/core/config_error.hpp"
+#include "common/sim/episode_pushes.hpp"
 #include "common/symmetry/group_element.hpp"
 
 namespace masa::task {
@@ -62,6 +64,9 @@ Task::Task(std::string name, std::shared_ptr<const MujocoModel> model, sym::Symm
     mj_deleteData(data_);
     data_ = mj_makeData(model_->get());
     randomization_ = std::make_unique<PhysicsRandomization>(randomization, m, spec_, action_joint_, action_actuator_);
+    if (randomization.push_velocity > 0.0 && base_vadr_ < 0)
+      throw ConfigError(params.origin("randomization.push_velocity"), "env.randomization.push_velocity",
+                        "pushes move the robot base, and " + name_ + "'s spec names no robot-base free joint");
   }
 }
 
@@ -117,6 +122,7 @@ void Task::reset(Rng& rng) {
     randomization_->drawEpisode(rng);
     noise_seed_ = static_cast<double>(rng() >> 11);  // exact in a double: saved with the state
     commanded_.assign(static_cast<std::size_t>(randomization_->latencySteps()) + 2, std::vector<double>(actDim(), 0.0));
+    randomization_->summarize(episode_.physics);
   }
   mj_resetData(model_->get(), data_);
   std::fill(last_action_.begin(), last_action_.end(), 0.0);
@@ -208,12 +214,24 @@ void Task::advancePhysics(const float* action) {
       beforeSubstep();
       mj_step(m, data_);
     }
+    pushIfDue();
     return;
   }
   for (int s = 0; s < frame_skip_; ++s) {
     beforeSubstep();
     mj_step(m, data_);
   }
+  if (randomization_) pushIfDue();
+}
+
+void Task::pushIfDue() {
+  const RandomizationConfig& c = randomization_->config();
+  Push push;
+  if (!pushAtStep(c.push_velocity, c.push_interval_s, controlTimestep(), static_cast<uint64_t>(noise_seed_),
+                  episode_.length, &push))
+    return;
+  data_->qvel[base_vadr_] += push.dvx;
+  data_->qvel[base_vadr_ + 1] += push.dvy;
 }
 
 void Task::setControls(const float* action) {

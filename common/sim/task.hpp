@@ -37,6 +37,7 @@ struct EpisodeStats {
   double ret = 0.0;
   int length = 0;
   std::vector<double> term_sums;  // per reward term, weighted, in rewardTermNames() order
+  std::vector<double> physics;    // env.randomization's draws of the episode, in physicsDrawNames() order
   bool has_success = false;
   bool success = false;
   bool terminated = false;
@@ -133,6 +134,10 @@ class Task {
   const mjModel* model() const { return model_->get(); }
   // The episode's randomized physics (null without env.randomization).
   const PhysicsRandomization* randomization() const { return randomization_.get(); }
+  // The names of EpisodeStats::physics: empty without env.randomization.
+  std::vector<std::string> physicsDrawNames() const {
+    return randomization_ ? PhysicsRandomization::drawNames() : std::vector<std::string>{};
+  }
   const MujocoModel& mujocoModel() const { return *model_; }  // with its file path and named lookups
   const mjData* data() const { return data_; }
   mjData* data() { return data_; }
@@ -178,6 +183,10 @@ class Task {
 
   // --- helpers for tasks ---
   int frameSkip() const { return frame_skip_; }
+  // The episode's scales of action k's PD gains (env.randomization.pd_kp_scale / pd_kd_scale; 1
+  // without): a task's own PD loop multiplies its gains by them.
+  double kpScale(int k) const { return randomization_ ? randomization_->kpScale(k) : 1.0; }
+  double kdScale(int k) const { return randomization_ ? randomization_->kdScale(k) : 1.0; }
   // The weight env.weights.<term> of one of the task's reward terms; the termination reward.
   double termWeight(const std::string& term) const;
   double terminationReward() const { return termination_reward_; }
@@ -201,6 +210,7 @@ class Task {
  private:
   void bindActuators();
   void setControls(const float* action);  // clamp, remember as the last action, applyAction
+  void pushIfDue();                       // env.randomization's push of this step (episode_pushes.hpp)
   void transformJoints(int i);
   // mj_forward for a state set from outside (loaded, transformed): the derived quantities, while
   // the two parts of the state mj_forward writes stay as set. It normalizes the quaternions in qpos

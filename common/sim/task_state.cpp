@@ -125,6 +125,7 @@ void Task::loadState(std::span<const double> in) {
       throw std::runtime_error("task state of " + name_ + ": the randomized physics says " + std::to_string(n) + " values");
     const std::span<const double> block = r.take(static_cast<std::size_t>(n), "the randomized physics");
     std::size_t at = randomization_->load(block, name_);
+    randomization_->summarize(episode_.physics);  // the episode statistics' record of the draws
     if (block.size() < at + 2) throw std::runtime_error("task state of " + name_ + ": the randomized physics is cut short");
     noise_seed_ = block[at++];
     const double steps = block[at++];

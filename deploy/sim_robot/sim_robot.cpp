@@ -13,12 +13,16 @@ SimRobot::SimRobot(task::Task& task, const sym::SymmetrySpec& spec)
   qpos_adr_.resize(n_);
   qvel_adr_.resize(n_);
   actuator_.resize(n_);
+  driver_gear_.resize(n_);
   for (int k = 0; k < n_; ++k) {
     const int j = task_.jointOfAction(k);
     if (j < 0) throw std::runtime_error("action " + std::to_string(k) + " drives no joint");
     qpos_adr_[k] = model_->jnt_qposadr[j];
     qvel_adr_[k] = model_->jnt_dofadr[j];
     actuator_[k] = task_.actuatorOfAction(k);
+    // The motor driver knows the nominal gear: a perturbed (weaker or stronger) motor gives another torque.
+    const task::PhysicsRandomization* perturbation = task_.randomization();
+    driver_gear_[k] = perturbation ? perturbation->nominalGear(actuator_[k]) : model_->actuator_gear[6 * actuator_[k]];
   }
   for (const auto& fj : spec.mujoco().free_joints)
     if (fj.kind == sym::FreeJointKind::kRobotBase) {
@@ -64,7 +68,7 @@ void SimRobot::step(const masa::lcmt_robot_command& cmd) {
     const int a = actuator_[k];
     const double tau = cmd.kp[k] * (cmd.position[k] - d->qpos[qpos_adr_[k]]) +
                        cmd.kd[k] * (cmd.velocity[k] - d->qvel[qvel_adr_[k]]) + cmd.torque_ff[k];
-    double u = tau / m->actuator_gear[6 * a];
+    double u = tau / driver_gear_[k];
     if (m->actuator_ctrllimited[a]) u = std::clamp(u, m->actuator_ctrlrange[2 * a], m->actuator_ctrlrange[2 * a + 1]);
     d->ctrl[a] = std::isfinite(u) ? u : 0.0;
   }

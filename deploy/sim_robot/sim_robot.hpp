@@ -2,7 +2,8 @@
 // drives its motors. It reads the state a robot reports (joint angles, velocities and torques, the
 // base pose and twist from the task's robot-base free joint) and applies a command with the PD law
 // at every physics step: torque = kp (position - q) + kd (velocity - qdot) + torque_ff, divided by
-// the actuator's gear and clipped to its control range (a non-finite result becomes 0).
+// the actuator's nominal gear (so a perturbed gear, a weaker or stronger motor, changes the torque)
+// and clipped to its control range (a non-finite result becomes 0).
 #pragma once
 
 #include <vector>
@@ -45,6 +46,7 @@ class SimRobot {
   mjData* data_;
   int n_;
   std::vector<int> qpos_adr_, qvel_adr_, actuator_;
+  std::vector<double> driver_gear_;  // torque to control: the nominal gear, whatever the perturbation drew
   int base_qpos_ = -1, base_qvel_ = -1;  // the robot-base free joint's, if the task has one
 };
 

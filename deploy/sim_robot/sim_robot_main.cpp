@@ -7,6 +7,10 @@
 // --damping-kd) instead of holding the last targets, and no longer follows the runner that went
 // quiet; a new runner takes over (deploy/sim_robot/command_timeout.hpp).
 //   masa_sim_robot tasks/a1_beam/policy/policy.bin --seed 0 --duration 12
+// A robot that is not the model (issue #52, item 2): --perturb KEY=VALUE (repeatable) and
+// --perturb-file FILE take env.randomization's keys, fixed values or ranges drawn from --seed
+// (deploy/sim_robot/perturbation.hpp); the robot prints what it drew, read back from its model:
+//   masa_sim_robot POLICY --insecure --perturb env.randomization.mass_scale=1.2 --perturb actuator_strength=0.85
 // At the end it prints the task's progress figures over the policy phase (commands in mode 1)
 // and whether the task's termination test fired (a fall). Fault injection for tests:
 // --stop-state-after S stops publishing state, --nan-state-after S publishes NaN joint angles;
@@ -43,6 +47,7 @@
 #include "deploy/sim_robot/command_lead.hpp"
 #include "deploy/sim_robot/command_link.hpp"
 #include "deploy/sim_robot/command_timeout.hpp"
+#include "deploy/sim_robot/perturbation.hpp"
 #include "deploy/sim_robot/run_record.hpp"
 #include "deploy/sim_robot/sim_robot.hpp"
 #include "masa/lcmt_robot_command.hpp"
@@ -108,6 +113,12 @@ int main(int argc, char** argv) {
   bool insecure = false;
   app.add_flag("--insecure", insecure, "take unsigned commands, send unsigned state: anyone on the network commands the robot")
       ->excludes(roster_opt)->excludes(key_opt);
+  std::vector<std::string> perturb;
+  std::string perturb_file;
+  app.add_option("--perturb", perturb,
+                 "a robot that is not the model: KEY=VALUE of env.randomization (e.g. env.randomization.mass_scale=1.2, "
+                 "actuator_strength=[0.8,0.9]); ranges drawn from --seed; repeatable");
+  app.add_option("--perturb-file", perturb_file, "a YAML file of env.randomization keys (as --perturb)")->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
   if (!insecure && roster_file.empty()) {
     std::fprintf(stderr, "masa_sim_robot: the robot channels are signed: give --roster DIR/roster --signing-key "
@@ -119,11 +130,24 @@ int main(int argc, char** argv) {
 
   try {
     policy::LoadedPolicy lp = policy::loadPolicyFile(policy_path);
-    task::TaskFactory factory(task::taskCatalog(), lp.config.task, lp.spec, lp.config.env, lp.config.origin, lp.source);
+    bool perturbed = false;
+    const YAML::Node env = deploy::perturbedEnv(lp.config.env, perturb, perturb_file, lp.config.origin, &perturbed);
+    task::TaskFactory factory(task::taskCatalog(), lp.config.task, lp.spec, env, lp.config.origin, lp.source);
     std::unique_ptr<task::Task> task = factory.create();
     Rng rng(seed);
     task->reset(rng);
     deploy::SimRobot robot(*task, lp.spec);
+    std::unique_ptr<deploy::StateNoise> state_noise;
+    if (perturbed) {
+      const task::PhysicsRandomization& p = *task->randomization();
+      const double latency_ms = (p.latencySteps() + p.latencyFraction()) * task->controlTimestep() * 1e3;
+      delay_ms += latency_ms;
+      Rng noise_rng(seed ^ 0x5eed5eedULL);
+      state_noise = std::make_unique<deploy::StateNoise>(p.config(), robot.numJoints(), noise_rng);
+      std::fprintf(stderr, "masa_sim_robot: perturbed robot: %s\n", deploy::describePerturbation(*task).c_str());
+      std::fprintf(stderr, "masa_sim_robot: perturbed robot: latency %.1f ms (command delay now %.1f ms), state noise std %g, "
+                           "bias up to %g\n", latency_ms, delay_ms, p.config().obs_noise_std, p.config().obs_bias);
+    }
     const int n = robot.numJoints();
     const deploy::StateFaults state_faults{nan_state_after, tilt_state_after, tilt_rad};
     if (insecure)
@@ -173,6 +197,7 @@ int main(int argc, char** argv) {
     int64_t utime = 0;
     const auto publishState = [&](double sim_t) {
       robot.fillState(st, state_faults, sim_t);
+      if (state_noise && state_noise->active()) state_noise->apply(st);
       st.utime = utime = std::max(utime + 1, transport::wallClockMicros());
       if (!link.loseState()) state_out.publish(state_channel, st);
     };

@@ -190,7 +190,7 @@ class A1Beam final : public Task {
 
   void beforeSubstep() override {
     for (int k = 0; k < kNumJoints; ++k) {
-      const double tau = kp_ * (targets_[k] - data_->qpos[qadr_[k]]) - kd_ * data_->qvel[vadr_[k]];
+      const double tau = kp_ * kpScale(k) * (targets_[k] - data_->qpos[qadr_[k]]) - kd_ * kdScale(k) * data_->qvel[vadr_[k]];
       data_->ctrl[actuatorOfAction(k)] = std::clamp(tau, -torque_limit_[k], torque_limit_[k]);
     }
   }

@@ -218,7 +218,7 @@ class TrifingerLift final : public Task {
   void beforeSubstep() override {
     for (int k = 0; k < kJoints; ++k) {
       const double qd = data_->qvel[dof_adr_[k]];
-      double tau = kp_ * (q_target_[k] - data_->qpos[qpos_adr_[k]]) - kd_ * qd;
+      double tau = kp_ * kpScale(k) * (q_target_[k] - data_->qpos[qpos_adr_[k]]) - kd_ * kdScale(k) * qd;
       // Speed limit of the motors: above it a motor only brakes.
       if (qd > max_velocity_) tau = std::min(tau, 0.0);
       if (qd < -max_velocity_) tau = std::max(tau, 0.0);

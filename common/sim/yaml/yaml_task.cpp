@@ -115,8 +115,8 @@ class YamlTask final : public Task {
     const mjModel* m = model();
     for (int k = 0; k < actDim(); ++k) {
       const int j = jointOfAction(k);
-      const double tau = config_.actuation.kp * (targets_[k] - data_->qpos[m->jnt_qposadr[j]]) -
-                         config_.actuation.kd * data_->qvel[m->jnt_dofadr[j]];
+      const double tau = config_.actuation.kp * kpScale(k) * (targets_[k] - data_->qpos[m->jnt_qposadr[j]]) -
+                         config_.actuation.kd * kdScale(k) * data_->qvel[m->jnt_dofadr[j]];
       data_->ctrl[actuatorOfAction(k)] = std::clamp(tau, -torque_limit_[k], torque_limit_[k]);
     }
   }
