@@ -37,8 +37,10 @@ class Descriptor {
 };
 
 void checkDirectory(const std::string& path, const std::string& what) {
-  std::string dir = std::filesystem::path(path).parent_path().string();
-  if (dir.empty()) dir = ".";
+  // A file named without a directory is in the working one. (Built, not assigned: GCC 12's
+  // -Wstringop-overflow misfires on assigning "." to the string.)
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  const std::string dir = parent.empty() ? std::string(".") : parent.string();
   const Descriptor fd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   struct stat st {};
   if (fd.get() < 0 || ::fstat(fd.get(), &st) != 0)
