@@ -21,17 +21,17 @@
 namespace masa::test {
 namespace {
 
-struct Robot {
+struct PerturbedRobot {
   task::TaskFactory factory;
   std::unique_ptr<task::Task> task;
   std::unique_ptr<deploy::SimRobot> robot;
 };
 
-std::unique_ptr<Robot> makeRobot(const std::vector<std::string>& perturb, uint64_t seed = 0) {
+std::unique_ptr<PerturbedRobot> makePerturbedRobot(const std::vector<std::string>& perturb, uint64_t seed = 0) {
   std::map<std::string, std::string> origin;
   bool perturbed = false;
   YAML::Node env = deploy::perturbedEnv(shippedEnv("a1_beam"), perturb, "", origin, &perturbed);
-  auto r = std::unique_ptr<Robot>(new Robot{task::TaskFactory(task::taskCatalog(), "a1_beam", shippedSpec("a1_beam"), env, origin),
+  auto r = std::unique_ptr<PerturbedRobot>(new PerturbedRobot{task::TaskFactory(task::taskCatalog(), "a1_beam", shippedSpec("a1_beam"), env, origin),
                                             nullptr, nullptr});
   r->task = r->factory.create();
   Rng rng(seed);
@@ -54,7 +54,7 @@ masa::lcmt_robot_command holdCommand(const deploy::SimRobot& robot, double torqu
   return c;
 }
 
-std::vector<double> stateAfter(Robot& r, int steps) {
+std::vector<double> stateAfter(PerturbedRobot& r, int steps) {
   const masa::lcmt_robot_command c = holdCommand(*r.robot, 0.0);
   for (int i = 0; i < steps; ++i) r.robot->step(c);
   r.robot->updateKinematics();
@@ -94,14 +94,14 @@ TEST(SimRobotPerturbation, NoPerturbationIsBitForBitTheNominalRobot) {
   const YAML::Node out = deploy::perturbedEnv(env, {}, "", origin, &perturbed);
   EXPECT_FALSE(perturbed);
   EXPECT_EQ(YAML::Dump(out), YAML::Dump(env));
-  auto a = makeRobot({}), b = makeRobot({});
+  auto a = makePerturbedRobot({}), b = makePerturbedRobot({});
   EXPECT_EQ(a->task->randomization(), nullptr);
   EXPECT_EQ(stateAfter(*a, 200), stateAfter(*b, 200));
 }
 
 TEST(SimRobotPerturbation, APerturbedRobotMovesOtherwiseUnderTheSameCommandsReadBackFromItsModel) {
-  auto nominal = makeRobot({});
-  auto heavy = makeRobot({"env.randomization.mass_scale=1.3", "geom_friction_scale=0.6"});
+  auto nominal = makePerturbedRobot({});
+  auto heavy = makePerturbedRobot({"env.randomization.mass_scale=1.3", "geom_friction_scale=0.6"});
   const mjModel* m0 = nominal->task->model();
   const mjModel* m1 = heavy->task->model();
   for (int b = 1; b < m0->nbody; ++b) EXPECT_NEAR(m1->body_mass[b], 1.3 * m0->body_mass[b], 1e-9 * m0->body_mass[b]);
@@ -115,8 +115,8 @@ TEST(SimRobotPerturbation, APerturbedRobotMovesOtherwiseUnderTheSameCommandsRead
 }
 
 TEST(SimRobotPerturbation, AWeakerMotorGivesLessTorqueForTheSameCommand) {
-  auto nominal = makeRobot({});
-  auto weak = makeRobot({"actuator_strength=0.7"});
+  auto nominal = makePerturbedRobot({});
+  auto weak = makePerturbedRobot({"actuator_strength=0.7"});
   for (auto* r : {nominal.get(), weak.get()}) {
     masa::lcmt_robot_command c = holdCommand(*r->robot, 1.0);
     std::fill(c.kp.begin(), c.kp.end(), 0.0);
@@ -135,7 +135,7 @@ TEST(SimRobotPerturbation, AWeakerMotorGivesLessTorqueForTheSameCommand) {
 TEST(SimRobotPerturbation, ABadValueIsRefusedNamingTheKeyAndWhereItCameFrom) {
   for (const std::string bad : {"mass_scale=-1", "mass_scale=[1.3, 1.1]", "actuator_strength=.nan", "mass_scal=1.2"}) {
     try {
-      makeRobot({bad});
+      makePerturbedRobot({bad});
       ADD_FAILURE() << bad << " was taken";
     } catch (const ConfigError& e) {
       const std::string what = e.what();
