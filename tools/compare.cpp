@@ -2,7 +2,7 @@
 // median and 25-75% band over seeds of each method's training return, evaluation return and the
 // task's progress figure against env steps, the training return against wall-clock time, and a
 // verdict of the reference method (MASA) against each baseline with bootstrap intervals over seeds.
-//   masa_compare experiments/results/a1_beam_grid            (DIR/<task>/<method>_s<seed>/metrics.csv)
+//   masa_compare experiments/results/a1_beam_grid            (DIR/<task>/<method>_s<seed>/metrics.csv or .csv.xz)
 //   masa_compare DIR --reference masa --resamples 10000 --no-plot
 //   masa_compare DIR --milestone eval_distance_m=5     (when each run's evaluation first walks 5 m)
 //   masa_compare DIR --milestone 'eval_position_error_m<=0.05'   (a figure that falls: the cube first within 5 cm)
@@ -50,8 +50,34 @@ struct Run {
   }
 };
 
+// A run's metrics: metrics.csv, or metrics.csv.xz as recorded grids keep them (experiments/README.md,
+// the tree's budget), read through xz.
+fs::path metricsFile(const fs::path& run_dir) {
+  const fs::path plain = run_dir / "metrics.csv", packed = run_dir / "metrics.csv.xz";
+  return fs::exists(plain) || !fs::exists(packed) ? plain : packed;
+}
+
+std::string decompressed(const fs::path& xz) {
+  FILE* p = ::popen(("xz -dc -- " + shellQuoted(xz.string())).c_str(), "r");
+  if (!p) throw std::runtime_error(xz.string() + ": cannot start xz to read it");
+  std::string text;
+  char buf[65536];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) text.append(buf, n);
+  if (::pclose(p) != 0) throw std::runtime_error(xz.string() + ": xz could not read it (is xz-utils installed, is the file whole?)");
+  return text;
+}
+
 Run readRun(const fs::path& csv) {
-  std::ifstream in(csv);
+  std::ifstream file;
+  std::istringstream unpacked;
+  std::istream* source = &file;
+  if (csv.extension() == ".xz") {
+    unpacked.str(decompressed(csv));
+    source = &unpacked;
+  } else {
+    file.open(csv);
+  }
+  std::istream& in = *source;
   if (!in) throw std::runtime_error(csv.string() + ": cannot read");
   std::string line;
   if (!std::getline(in, line)) throw std::runtime_error(csv.string() + ": empty (no header)");
@@ -462,8 +488,9 @@ std::optional<TaskResult> compareTask(const fs::path& dir, const std::string& ta
       std::cerr << "masa_compare: skipped " << (dir / task / name).string() << ": " << kPlotSafeRule << "\n";
       continue;
     }
-    if (!fs::exists(e.path() / "metrics.csv")) continue;
-    Run run = readRun(e.path() / "metrics.csv");
+    const fs::path csv = metricsFile(e.path());
+    if (!fs::exists(csv)) continue;
+    Run run = readRun(csv);
     if (run.rows() < 2) continue;
     run.method = m[1];
     run.seed = std::stoi(m[2]);

@@ -101,6 +101,14 @@ if command -v gnuplot > /dev/null; then
   [ -s grid/a1_beam/compare.png ] && [ -s grid/compare_all.png ] || fail "no figures"
 fi
 grep -q "| sa | " grid/verdict.md || fail "the verdict has no row for sa"
+# 2b. A recorded grid keeps its metrics as metrics.csv.xz (experiments/README.md, the tree's budget):
+# masa_compare reads them as it reads the plain files.
+mkdir -p packed/a1_beam
+for m in masa sa; do mkdir -p "packed/a1_beam/${m}_s0" && xz -c "grid/a1_beam/${m}_s0/metrics.csv" > "packed/a1_beam/${m}_s0/metrics.csv.xz"; done
+"$build/tools/masa_compare" packed > packed.out 2>&1 || fail "masa_compare on a grid of metrics.csv.xz failed: $(cat packed.out)"
+"$build/tools/masa_compare" grid > plain.out 2>&1 || fail "masa_compare on the grid failed: $(cat plain.out)"
+cmp -s <(grep "^| " grid/verdict.md) <(grep "^| " packed/verdict.md) ||
+  fail "masa_compare's verdict on metrics.csv.xz differs from the plain files': $(diff <(grep '^| ' grid/verdict.md) <(grep '^| ' packed/verdict.md) | head -4)"
 
 # 3. A third call redoes nothing and redraws the comparison.
 logs_before=$(cat grid/a1_beam/*.log | wc -l)
