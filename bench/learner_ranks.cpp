@@ -64,7 +64,7 @@ class TimedCommunicator final : public masa::cluster::Communicator {
   masa::cluster::Communicator& inner_;
 };
 
-void fillBatch(masa::ppo::RolloutBuffer& b, masa::Rng& rng) {
+void fillBatch(masa::rollout::RolloutBuffer& b, masa::Rng& rng) {
   std::normal_distribution<float> n(0.f, 1.f);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   b.clear();
@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   masa::ppo::PpoTrainer trainer(model, adam, rc.ppo, timed);
-  masa::ppo::RolloutBuffer buffer(rc.rollout.num_envs / ranks.size(), rc.rollout.horizon, model.obsDim(), model.actDim());
+  masa::rollout::RolloutBuffer buffer(rc.rollout.num_envs / ranks.size(), rc.rollout.horizon, model.obsDim(), model.actDim());
   masa::Rng data(1000 + ranks.rank()), shuffle(rc.seed);
 
   double prepare_s = 0, optimize_s = 0, wall_s = 0;

@@ -17,7 +17,7 @@
 #include "common/core/types.hpp"
 #include "common/integrity/sealed_file.hpp"
 #include "common/model/actor_critic.hpp"
-#include "learner/ppo/rollout_buffer.hpp"
+#include "common/rollout/rollout_buffer.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
 namespace masa::learner {
@@ -45,7 +45,7 @@ class Algorithm {
   // Learns from this rank's batch (the rounds' collectives inside, for data-parallel ranks).
   // env_streams names each environment column's source, the same id for the same actor's
   // environment every round (an episode's stretches are then known as one).
-  virtual LearnFigures learn(ppo::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) = 0;
+  virtual LearnFigures learn(rollout::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) = 0;
   // The last learn()'s part of the progress line.
   virtual std::string progressFigures(const LearnFigures& figures) const = 0;
   // A table of one row per round beside metrics.csv, with every figure the algorithm has (its

@@ -83,7 +83,7 @@ Learner::Learner(const config::RunConfig& rc, const LearnerOptions& options)
   algorithm_ = opt_.make_algorithm(rc_, rng_, *ranks_);
   MASA_CHECK(ranks_->size() == 1 || algorithm_->dataParallel(),
              "learner: " << rc_.learner << " runs on one learner rank (" << ranks_->size() << " given)");
-  buffer_ = std::make_unique<ppo::RolloutBuffer>(rank_envs_, rc_.rollout.horizon, obs_dim_, act_dim_);
+  buffer_ = std::make_unique<rollout::RolloutBuffer>(rank_envs_, rc_.rollout.horizon, obs_dim_, act_dim_);
 
   run_id_ = options.run_id;
   if (opt_.resume) loadCheckpoint();  // sets run_id_ unless one was given

@@ -38,7 +38,7 @@
 #include "learner/params_delivery.hpp"
 #include "learner/update_report.hpp"
 #include "learner/algorithm.hpp"
-#include "learner/ppo/rollout_buffer.hpp"
+#include "common/rollout/rollout_buffer.hpp"
 #include "learner/silence_watch.hpp"
 #include "masa/lcmt_actor_heartbeat.hpp"
 
@@ -163,7 +163,7 @@ class Learner {
   Rng rng_;
   int obs_dim_ = 0, act_dim_ = 0;  // the task's (its symmetry spec's)
   std::unique_ptr<Algorithm> algorithm_;
-  std::unique_ptr<ppo::RolloutBuffer> buffer_;  // the batch
+  std::unique_ptr<rollout::RolloutBuffer> buffer_;  // the batch
   BatchOrigin origin_;  // where the batch's environments came from: their policy versions (the lag)
   std::vector<int64_t> env_streams_;  // each batch column's stream id (Algorithm::learn)
 

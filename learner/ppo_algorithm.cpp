@@ -68,7 +68,7 @@ std::unique_ptr<Algorithm> makePpoAlgorithm(const config::RunConfig& rc, Rng& rn
   return std::make_unique<PpoAlgorithm>(rc, rng, ranks);
 }
 
-LearnFigures PpoAlgorithm::learn(ppo::RolloutBuffer& batch, std::span<const int64_t>, Rng& rng) {
+LearnFigures PpoAlgorithm::learn(rollout::RolloutBuffer& batch, std::span<const int64_t>, Rng& rng) {
   trainer_->prepare(batch);
   if (!restored_order_.empty()) {
     // A resumed run continues the shuffle of the run it resumes (see PpoTrainer::shuffleOrder).

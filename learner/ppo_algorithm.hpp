@@ -19,7 +19,7 @@ class PpoAlgorithm final : public Algorithm {
   PpoAlgorithm(const config::RunConfig& rc, Rng& rng, cluster::Communicator& ranks);
 
   std::string kind() const override { return "ppo"; }
-  LearnFigures learn(ppo::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) override;
+  LearnFigures learn(rollout::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) override;
   std::string progressFigures(const LearnFigures& figures) const override;
   std::string curveScript(const std::string& title, const std::vector<std::string>& term_names,
                           bool has_success) const override;

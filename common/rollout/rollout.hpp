@@ -4,7 +4,7 @@
 // every per-step array, and its vector occupies [(t * E + e) * dim, (t * E + e + 1) * dim). This is
 // the order an actor writes (all environments advance one step together), the order of the wire
 // chunk (lcmt_rollout_chunk, the same layout over a run of whole environments), the order of the
-// learner's intake pool, and the memory of ppo::RolloutBuffer's matrices (column t * E + e), which
+// learner's intake pool, and the memory of rollout::RolloutBuffer's matrices (column t * E + e), which
 // are views over a Rollout. So the data is copied between these stages, never re-arranged.
 //
 // Truncations (time-outs) have one encoding everywhere: the step index t * E + e, ascending, and

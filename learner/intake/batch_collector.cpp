@@ -135,13 +135,13 @@ void BatchCollector::add(const ValidatedChunk& chunk) {
   rollout::appendEnvironmentEvents(m, p, copy);
 }
 
-bool BatchCollector::take(ppo::RolloutBuffer& out, BatchOrigin* origin) {
+bool BatchCollector::take(rollout::RolloutBuffer& out, BatchOrigin* origin) {
   if (!ready()) return false;
   takeEnvs(out, cfg_.num_envs, origin);
   return true;
 }
 
-bool BatchCollector::takeShort(ppo::RolloutBuffer& out, int min_envs, BatchOrigin* origin) {
+bool BatchCollector::takeShort(rollout::RolloutBuffer& out, int min_envs, BatchOrigin* origin) {
   MASA_CHECK(min_envs > 0, "a short batch needs at least one environment, asked for " << min_envs);
   if (used_ < min_envs) return false;
   const int n = std::min(used_, cfg_.num_envs);
@@ -150,7 +150,7 @@ bool BatchCollector::takeShort(ppo::RolloutBuffer& out, int min_envs, BatchOrigi
   return true;
 }
 
-void BatchCollector::takeEnvs(ppo::RolloutBuffer& out, int B, BatchOrigin* origin) {
+void BatchCollector::takeEnvs(rollout::RolloutBuffer& out, int B, BatchOrigin* origin) {
   const int T = cfg_.horizon, od = cfg_.obs_dim, ad = cfg_.act_dim, C = capacity_;
   MASA_CHECK(out.horizon() == T && out.obsDim() == od && out.actDim() == ad,
              "rollout buffer is " << out.horizon() << " steps, obs " << out.obsDim() << ", act " << out.actDim()

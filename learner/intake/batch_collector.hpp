@@ -4,7 +4,7 @@
 // evicted when the learner's version advances, and counted.
 //
 // The pool is one rollout::Rollout of capacity_envs environments allocated once, in the layout of
-// the chunks and of ppo::RolloutBuffer (step-major): each environment of a chunk is copied into a
+// the chunks and of rollout::RolloutBuffer (step-major): each environment of a chunk is copied into a
 // free slot (a column of the pool) as it arrives, and take() copies the chosen columns straight
 // into the PPO buffer. Truncations and episodes are kept in the pool's own lists, indexed by slot.
 #pragma once
@@ -15,7 +15,7 @@
 
 #include "common/rollout/rollout.hpp"
 #include "learner/intake/rollout_assembler.hpp"
-#include "learner/ppo/rollout_buffer.hpp"
+#include "common/rollout/rollout_buffer.hpp"
 
 namespace masa::learner {
 
@@ -61,16 +61,16 @@ class BatchCollector {
   // environments, oldest version first (then arrival order), episodes and truncations renumbered to
   // batch columns, frees their slots and returns true; otherwise returns false and leaves `out`
   // alone. `origin`, when given, says where each column came from.
-  bool take(ppo::RolloutBuffer& out, BatchOrigin* origin = nullptr);
+  bool take(rollout::RolloutBuffer& out, BatchOrigin* origin = nullptr);
   // A batch short of environments that were lost: when at least min_envs (> 0) are buffered, takes
   // them all (at most num_envs) as take() does, and sets `out` to that many environments.
-  bool takeShort(ppo::RolloutBuffer& out, int min_envs, BatchOrigin* origin = nullptr);
+  bool takeShort(rollout::RolloutBuffer& out, int min_envs, BatchOrigin* origin = nullptr);
 
   const CollectorStats& stats() const { return stats_; }
   const CollectorConfig& config() const { return cfg_; }
 
  private:
-  void takeEnvs(ppo::RolloutBuffer& out, int num_envs, BatchOrigin* origin);
+  void takeEnvs(rollout::RolloutBuffer& out, int num_envs, BatchOrigin* origin);
   int freeSlotFor(int64_t version);  // -1 when full of environments at least as new
   void release(int slot);
   // Forgets the truncations and episodes of released slots (before a slot is reused or read).

@@ -14,9 +14,15 @@
 #pragma once
 
 #include "common/core/types.hpp"
-#include "learner/ppo/rollout_buffer.hpp"
+#include "common/rollout/rollout_buffer.hpp"
 
 namespace masa::ppo {
+
+// PPO learns from the learner's batch: the rollout's layout with its views (common/rollout).
+using rollout::FinalObsEntry;
+using rollout::FlagMat;
+using rollout::RolloutBuffer;
+using rollout::StepMat;
 
 struct GaeConfig {
   double gamma = 0.99;

@@ -35,7 +35,7 @@
 #include "learner/ppo/adaptive_lr.hpp"
 #include "learner/ppo/gae.hpp"
 #include "learner/ppo/ppo_loss.hpp"
-#include "learner/ppo/rollout_buffer.hpp"
+#include "common/rollout/rollout_buffer.hpp"
 
 namespace masa::ppo {
 

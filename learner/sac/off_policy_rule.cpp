@@ -52,7 +52,7 @@ OffPolicyRule::OffPolicyRule(const config::RunConfig& rc, Rng& rng)
 
 OffPolicyRule::~OffPolicyRule() = default;
 
-learner::LearnFigures OffPolicyRule::learn(ppo::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) {
+learner::LearnFigures OffPolicyRule::learn(rollout::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) {
   return learn(batch.data(), env_streams, rng);
 }
 

@@ -48,7 +48,7 @@ class OffPolicyRule final : public learner::Algorithm {
   // Takes the batch's transitions into replay and makes the gradient steps owed. The figures that
   // have a metrics.csv column go there (actor_loss, critic_loss: twin Q, entropy, sym_policy_loss;
   // the others 0); roundFigures() has them all.
-  learner::LearnFigures learn(ppo::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) override;
+  learner::LearnFigures learn(rollout::RolloutBuffer& batch, std::span<const int64_t> env_streams, Rng& rng) override;
   learner::LearnFigures learn(const rollout::Rollout& batch, std::span<const int64_t> env_streams, Rng& rng);
   // Its gradient steps, twin-Q loss, temperature, entropy and mean Q, or that it still acts at random.
   std::string progressFigures(const learner::LearnFigures& figures) const override;

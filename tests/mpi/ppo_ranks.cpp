@@ -65,19 +65,19 @@ struct Learner {
     model->initialize(init);
     adam = std::make_unique<nn::Adam<float>>(model->params(), nn::AdamConfig<float>{});  // the learner's defaults
     trainer = std::make_unique<ppo::PpoTrainer>(*model, *adam, ppoConfig(), ranks);
-    buffer = std::make_unique<ppo::RolloutBuffer>(num_envs, kHorizon, spec.obsDim(), spec.actDim());
+    buffer = std::make_unique<rollout::RolloutBuffer>(num_envs, kHorizon, spec.obsDim(), spec.actDim());
   }
   sym::SymmetrySpec spec;
   std::unique_ptr<model::ActorCritic<float>> model;
   std::unique_ptr<nn::Adam<float>> adam;
   std::unique_ptr<ppo::PpoTrainer> trainer;
-  std::unique_ptr<ppo::RolloutBuffer> buffer;
+  std::unique_ptr<rollout::RolloutBuffer> buffer;
 };
 
 // A whole batch of `envs` environments from `rng` alone (so every rank makes the same one): random
 // observations and rewards, actions from the reference policy, terminations and time-outs.
 void fillBatch(Learner& l, Rng& rng) {
-  ppo::RolloutBuffer& b = *l.buffer;
+  rollout::RolloutBuffer& b = *l.buffer;
   b.clear();
   b.obs() = test::randomMatrix<float>(b.obsDim(), b.size(), rng);
   b.bootstrapObs() = test::randomMatrix<float>(b.obsDim(), b.numEnvs(), rng);
@@ -103,7 +103,7 @@ void fillBatch(Learner& l, Rng& rng) {
 }
 
 // Environments [first, first + out.numEnvs()) of `in`, with their time-outs.
-void copyEnvs(const ppo::RolloutBuffer& in, int first, ppo::RolloutBuffer& out) {
+void copyEnvs(const rollout::RolloutBuffer& in, int first, rollout::RolloutBuffer& out) {
   out.clear();
   const int n = out.numEnvs();
   for (int t = 0; t <= in.horizon(); ++t)

@@ -9,7 +9,7 @@
 
 #include "common/rollout/rollout.hpp"
 #include "learner/intake/batch_collector.hpp"
-#include "learner/ppo/rollout_buffer.hpp"
+#include "common/rollout/rollout_buffer.hpp"
 #include "masa/lcmt_policy_params.hpp"
 
 namespace masa::transport::testing {
@@ -61,7 +61,7 @@ inline void fillRandomRollout(rollout::Rollout& r, const RolloutShape& s, uint64
 // each of its columns came from.
 struct TakenBatch {
   explicit TakenBatch(const learner::CollectorConfig& c) : buffer(c.num_envs, c.horizon, c.obs_dim, c.act_dim) {}
-  ppo::RolloutBuffer buffer;
+  rollout::RolloutBuffer buffer;
   learner::BatchOrigin origin;
   const rollout::Rollout& data() const { return buffer.data(); }
 };

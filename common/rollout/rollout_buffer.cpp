@@ -1,8 +1,8 @@
-#include "learner/ppo/rollout_buffer.hpp"
+#include "common/rollout/rollout_buffer.hpp"
 
 #include "common/core/check.hpp"
 
-namespace masa::ppo {
+namespace masa::rollout {
 
 RolloutBuffer::RolloutBuffer(int num_envs, int horizon, int obs_dim, int act_dim) {
   MASA_CHECK(num_envs > 0 && horizon > 0 && obs_dim > 0 && act_dim > 0,
@@ -49,4 +49,4 @@ void RolloutBuffer::checkFinalObs() const {
              truncations << " truncated steps but " << numFinalObs() << " final observations: a truncated step has none");
 }
 
-}  // namespace masa::ppo
+}  // namespace masa::rollout

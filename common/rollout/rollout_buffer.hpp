@@ -14,7 +14,7 @@
 #include "common/core/types.hpp"
 #include "common/rollout/rollout.hpp"
 
-namespace masa::ppo {
+namespace masa::rollout {
 
 template <typename S>
 using StepMat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;  // T x E
@@ -104,4 +104,4 @@ class RolloutBuffer {
   StepMat<Scalar> values_, advantages_, returns_;
 };
 
-}  // namespace masa::ppo
+}  // namespace masa::rollout
