@@ -90,6 +90,7 @@ LoadedPolicy loadPolicyFile(const std::string& path, const std::string& configs_
   LoadedPolicy p;
   p.source = path;
   p.integrity = file.describe();
+  p.release = file.release;
   const std::string config_text = readText(is, path, "config");
   p.spec_text = readText(is, path, "spec");
   try {

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "common/config/run_config.hpp"
@@ -32,6 +33,7 @@ struct LoadedPolicy {
   std::unique_ptr<model::ActorCritic<float>> model;
   std::string source;     // the file it came from
   std::string integrity;  // how the file proved it is intact ("sealed (SHA-256 checked), signed by ...")
+  std::optional<integrity::SignedRelease> release;  // the release its verified signature names, if any
 };
 
 // What a policy file is inside its seal.

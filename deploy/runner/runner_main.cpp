@@ -29,6 +29,9 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <filesystem>
+#include <charconv>
 #include <random>
 #include <sched.h>
 #include <thread>
@@ -154,6 +157,7 @@ struct DeployArgs {
   uint64_t min_policy_version = 0;
   bool quiet = false, exit_on_trip = false, require_signed = false, verify_state = false, insecure = false;
   std::string trusted_keys_path, roster_file, signing_key;
+  std::string release_state;  // the newest release this robot accepted, kept across runs
 };
 
 // Parses the command line; returns an exit code when the program should end now (help, version,
@@ -174,6 +178,9 @@ int parseArgs(int argc, char** argv, DeployArgs& a) {
   app.add_flag("--require-signed", a.require_signed, "refuse a policy file not signed by a key of --trusted-keys");
   app.add_option("--min-policy-version", a.min_policy_version,
                  "with --require-signed: refuse a policy not signed as this release or a newer one (masa_seal sign --release-version)");
+  app.add_option("--release-state", a.release_state,
+                 "with --require-signed: a file of the robot's that keeps the newest release it accepted; an older "
+                 "one is refused from then on, without --min-policy-version (made when missing)");
   app.add_option("--trusted-keys", a.trusted_keys_path, "Ed25519 public key file (PEM), or a directory of *.pub files")
       ->check(CLI::ExistingPath);
   auto* roster_opt = app.add_option("--roster", a.roster_file,
@@ -204,6 +211,10 @@ int parseArgs(int argc, char** argv, DeployArgs& a) {
                                           : "masa_deploy: --trusted-keys is used with --require-signed (say both)\n");
     return 2;
   }
+  if (!a.release_state.empty() && !a.require_signed) {
+    std::fprintf(stderr, "masa_deploy: --release-state needs --require-signed (a release version is believed only as a trusted key signed it)\n");
+    return 2;
+  }
   if (a.min_policy_version > 0 && !a.require_signed) {
     std::fprintf(stderr, "masa_deploy: --min-policy-version needs --require-signed (a release version is believed only as a trusted key signed it)\n");
     return 2;
@@ -211,17 +222,49 @@ int parseArgs(int argc, char** argv, DeployArgs& a) {
   return -1;
 }
 
+// --release-state: the newest release this robot accepted (one decimal number; 0 when the file is
+// missing). Anything else in it is refused: a damaged state must not lower the floor.
+uint64_t readReleaseState(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return 0;
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  uint64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size())
+    throw std::runtime_error(path + ": not a release number (--release-state keeps one): '" + text.substr(0, 40) + "'");
+  return v;
+}
+
+// Written beside and renamed: a robot stopped while writing keeps the old floor, never none.
+void writeReleaseState(const std::string& path, uint64_t version) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << version << '\n';
+    if (!out) throw std::runtime_error(tmp + ": cannot write the release state");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
 // The policy file, its integrity checked (and its signature, with --require-signed).
 policy::LoadedPolicy loadCheckedPolicy(const DeployArgs& a) {
   integrity::TrustedKeys trusted;
   integrity::ReadRules rules;
+  uint64_t accepted = 0;
   if (a.require_signed) {
     trusted = integrity::TrustedKeys::load(a.trusted_keys_path);
     rules.require_signed_by = &trusted;
-    rules.min_release_version = a.min_policy_version;
+    if (!a.release_state.empty()) accepted = readReleaseState(a.release_state);
+    rules.min_release_version = std::max(a.min_policy_version, accepted);
   }
   policy::LoadedPolicy lp = policy::loadPolicyFile(a.policy_path, config::defaultConfigsDir(), rules);
   std::fprintf(stderr, "masa_deploy: %s: %s\n", a.policy_path.c_str(), lp.integrity.c_str());
+  if (!a.release_state.empty() && lp.release && lp.release->version > accepted) {
+    writeReleaseState(a.release_state, lp.release->version);
+    std::fprintf(stderr, "masa_deploy: %s: release %llu is the newest this robot accepted; older ones are refused from now on\n",
+                 a.release_state.c_str(), static_cast<unsigned long long>(lp.release->version));
+  }
   return lp;
 }
 

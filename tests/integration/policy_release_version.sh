@@ -4,7 +4,8 @@
 # --min-policy-version 2 must run release 2 and refuse (exit 2, saying why) release 1, the one
 # without a release, and release 1 whose version bytes were rewritten to 2 (the signature covers
 # them); --min-policy-version without --require-signed is refused. Before, a signature covered no
-# version: release 1 ran wherever release 2 did. Prints PASS and exits 0, or FAIL and exits 1.
+# version: release 1 ran wherever release 2 did. --release-state keeps the newest release a robot
+# ran, so an older one is refused without the operator's pin. Prints PASS and exits 0, or FAIL and exits 1.
 #   MASA_BUILD_DIR=build bash tests/integration/policy_release_version.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -43,4 +44,16 @@ expect_refused "release 1" "$work/release1.bin" "release 1, older than the newes
 expect_refused "signed without a release" "$work/plain.bin" "names no release version" "${pin[@]}"
 expect_refused "release 1 rewritten as 2" "$work/forged.bin" "signature does not verify" "${pin[@]}"
 expect_refused "--min-policy-version alone" "$work/release2.bin" "needs --require-signed" --min-policy-version 2
-echo "PASS: only a release at or above --min-policy-version signed by a trusted key runs"
+# --release-state: the robot keeps the newest release it ran, so release 1 is refused after release 2
+# ran even when the operator gives no --min-policy-version; a damaged state is refused, not read as 0.
+state=(--require-signed --trusted-keys "$work/release.pub" --release-state "$work/robot.release")
+"$deploy" "$work/release1.bin" "${state[@]}" "${robot[@]}" > "$work/deploy.log" 2>&1 || fail "release 1 with a new state refused: $(cat "$work/deploy.log")"
+[ "$(cat "$work/robot.release")" = 1 ] || fail "the state after release 1 holds '$(cat "$work/robot.release")'"
+"$deploy" "$work/release2.bin" "${state[@]}" "${robot[@]}" > "$work/deploy.log" 2>&1 || fail "release 2 after 1 refused: $(cat "$work/deploy.log")"
+[ "$(cat "$work/robot.release")" = 2 ] || fail "the state after release 2 holds '$(cat "$work/robot.release")'"
+expect_refused "release 1 after release 2 ran" "$work/release1.bin" "release 1, older than the newest accepted" "${state[@]}"
+[ "$(cat "$work/robot.release")" = 2 ] || fail "a refused release changed the state"
+echo "2x" > "$work/robot.release"
+expect_refused "a damaged release state" "$work/release2.bin" "not a release number" "${state[@]}"
+expect_refused "--release-state alone" "$work/release2.bin" "needs --require-signed" --release-state "$work/robot.release"
+echo "PASS: only a release at or above --min-policy-version signed by a trusted key runs, and none older than the robot's newest (--release-state)"
